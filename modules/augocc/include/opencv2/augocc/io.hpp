@@ -1,0 +1,128 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#ifndef OPENCV_AUGOCC_IO_HPP
+#define OPENCV_AUGOCC_IO_HPP
+
+#include <functional>
+#include <map>
+#include <vector>
+#include <opencv2/core.hpp>
+#include "opencv2/augocc/camera.hpp"
+
+/*
+The interchange contract (../shared/CONTRACT.md): tracks.yml, reconstruction.yml, masks and mattes
+folders, and frame sequences given as a video, an image folder or a printf pattern. Algorithms never
+parse files; they take these types. Every reader validates and throws cv::Exception (StsBadArg,
+StsParseError, StsBadSize, StsObjectNotFound) with a message that names the file and the key.
+Every writer writes to a temporary name and renames, so a failure leaves no partial file.
+*/
+
+namespace cv {
+namespace augocc {
+
+//! @addtogroup augocc
+//! @{
+
+/** @brief 2D feature tracks: the measurement matrix of the factorization.
+
+`tracks` is F x P CV_32FC2, (u, v) of track p in frame f, both NaN where not observed.
+*/
+struct CV_EXPORTS Tracks
+{
+    Size imageSize;
+    Mat tracks;
+
+    int frames() const { return tracks.rows; }
+    int points() const { return tracks.cols; }
+    //! True when track p is observed (finite) in frame f.
+    bool observed(int f, int p) const;
+    //! Observation of track p in frame f (NaN if unobserved).
+    Point2f at(int f, int p) const { return tracks.at<Point2f>(f, p); }
+    //! Number of frames in which track p is observed.
+    int observationCount(int p) const;
+    //! Throws when the matrix type, the size or a value is inconsistent. @param what names the source.
+    void validate(const String& what = String()) const;
+};
+
+/** @brief Cameras and 3D points. Row p of `points` belongs to column p of the tracks it came from;
+a row of NaN is a rejected or unreconstructed track. */
+struct CV_EXPORTS Reconstruction
+{
+    CameraModel model = SCALED_ORTHOGRAPHIC;
+    Size imageSize;
+    std::vector<Camera> cameras;  //!< any subset of frames, in increasing frame order
+    Mat points;                   //!< P x 3 CV_64F (may be empty)
+
+    //! Index into `cameras` of the camera of frame `frame`, or -1.
+    int findCamera(int frame) const;
+    //! Camera of frame `frame`; throws StsObjectNotFound when the frame has none.
+    const Camera& camera(int frame) const;
+    //! Projects a world point into frame `frame`.
+    Point2d project(int frame, const Vec3d& Xw) const { return camera(frame).project(Xw); }
+    //! Number of points whose row is finite.
+    int validPointCount() const;
+    //! Throws on any inconsistency (model mix, frame order, R not a rotation, s <= 0, bad shapes).
+    void validate(const String& what = String()) const;
+};
+
+//! Per-frame 8-bit masks of one object: frame index -> image (255 = object).
+typedef std::map<int, Mat> FrameMasks;
+//! Masks of several objects: object name -> its frames.
+typedef std::map<String, FrameMasks> ObjectMasks;
+
+//! @brief Reads tracks.yml (also .yml.gz / .json). Throws naming the file and key on error.
+CV_EXPORTS Tracks readTracks(const String& path);
+//! @brief Writes tracks.yml atomically.
+CV_EXPORTS void writeTracks(const String& path, const Tracks& tracks);
+
+//! @brief Reads reconstruction.yml. Throws naming the file and key on error.
+CV_EXPORTS Reconstruction readReconstruction(const String& path);
+//! @brief Writes reconstruction.yml atomically.
+CV_EXPORTS void writeReconstruction(const String& path, const Reconstruction& rec);
+
+/** @brief Reads a masks or mattes folder `DIR/<object>/%04d.png`.
+@param dir the folder.
+@param expectedSize if not empty, every mask must have this size (else StsBadSize naming the file).
+@return binary masks (0 / 255, CV_8U) after thresholding at > 127.
+*/
+CV_EXPORTS ObjectMasks readMasks(const String& dir, Size expectedSize = Size());
+/** @brief Writes masks as `DIR/<object>/%04d.png`. The whole folder tree is written under a
+temporary name and renamed into place, so a failure leaves no partial output. An existing `dir`
+is replaced. */
+CV_EXPORTS void writeMasks(const String& dir, const ObjectMasks& masks);
+
+/** @brief Sequential frames from a video file, an image folder (sorted by name), or a printf
+pattern such as `frames/%04d.png`. */
+class CV_EXPORTS FrameSource
+{
+public:
+    virtual ~FrameSource();
+    /** @brief Opens the input; throws StsObjectNotFound / StsBadArg naming it when it cannot be
+    opened or holds no frame. */
+    static Ptr<FrameSource> open(const String& input);
+    //! Number of frames (exact for folders and patterns; the container's count for videos).
+    virtual int count() const = 0;
+    //! Frame size.
+    virtual Size size() const = 0;
+    //! Frames per second (videos), else 25.
+    virtual double fps() const = 0;
+    //! Reads the next frame (BGR, CV_8UC3); false at the end. Throws on a corrupt frame.
+    virtual bool read(OutputArray frame) = 0;
+    //! Index of the frame the next read() returns.
+    virtual int position() const = 0;
+    //! Seeks so that the next read() returns frame `index`.
+    virtual void seek(int index) = 0;
+};
+
+/** @brief Writes `tmp` by calling `writer(tmpPath)` and renames it to `path` on success; on
+failure removes the temporary and rethrows. Used by every writer of the module (and the CLI). */
+CV_EXPORTS void writeAtomically(const String& path,
+                                const std::function<void(const String& tmpPath)>& writer);
+
+//! @}
+
+} // namespace augocc
+} // namespace cv
+
+#endif

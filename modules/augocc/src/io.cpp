@@ -1,0 +1,664 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#include "precomp.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace fs = std::filesystem;
+
+namespace cv {
+namespace augocc {
+
+namespace {
+
+bool isFinite2(const Point2f& p)
+{
+    return std::isfinite(p.x) && std::isfinite(p.y);
+}
+
+// Opens a FileStorage for reading with a clear error naming the file.
+FileStorage openForRead(const String& path)
+{
+    if (!fs::exists(path))
+        CV_Error(Error::StsObjectNotFound, path + ": file not found");
+    FileStorage storage;
+    try
+    {
+        storage.open(path, FileStorage::READ);
+    }
+    catch (const cv::Exception& e)
+    {
+        CV_Error(Error::StsParseError, path + ": cannot parse (" + e.err + ")");
+    }
+    if (!storage.isOpened())
+        CV_Error(Error::StsParseError, path + ": cannot open or parse as a FileStorage file");
+    return storage;
+}
+
+FileNode requireKey(const FileNode& parent, const char* key, const String& where)
+{
+    FileNode n = parent[key];
+    if (n.empty() || n.isNone())
+        CV_Error(Error::StsParseError, where + ": missing key '" + key + "'");
+    return n;
+}
+
+Mat readMatKey(const FileNode& parent, const char* key, const String& where)
+{
+    FileNode n = requireKey(parent, key, where);
+    if (!n.isMap())
+        CV_Error(Error::StsParseError, where + ": key '" + key + "' is not a matrix");
+    Mat m;
+    try
+    {
+        n >> m;
+    }
+    catch (const cv::Exception& e)
+    {
+        CV_Error(Error::StsParseError, where + ": key '" + key + "' is not a valid matrix (" +
+                 e.err + ")");
+    }
+    return m;
+}
+
+int readIntKey(const FileNode& parent, const char* key, const String& where)
+{
+    FileNode n = requireKey(parent, key, where);
+    if (!n.isInt())
+        CV_Error(Error::StsParseError, where + ": key '" + key + "' must be an integer");
+    return (int)n;
+}
+
+double readRealKey(const FileNode& parent, const char* key, const String& where)
+{
+    FileNode n = requireKey(parent, key, where);
+    if (!n.isReal() && !n.isInt())
+        CV_Error(Error::StsParseError, where + ": key '" + key + "' must be a number");
+    return (double)n;
+}
+
+Size readImageSize(const FileNode& root, const String& where)
+{
+    Mat m = readMatKey(root, "image_size", where);
+    if (m.total() != 2 || m.channels() != 1)
+        CV_Error(Error::StsBadSize, where + ": key 'image_size' must be a 1x2 matrix [width, height]");
+    Mat mi;
+    m.convertTo(mi, CV_32S);
+    Size sz(mi.at<int>(0), mi.at<int>(1));
+    if (sz.width <= 0 || sz.height <= 0)
+        CV_Error(Error::StsBadArg, where + cv::format(": key 'image_size' = [%d, %d] must be "
+                 "positive", sz.width, sz.height));
+    return sz;
+}
+
+template <typename M>
+M readFixedMat(const FileNode& parent, const char* key, const String& where)
+{
+    Mat m = readMatKey(parent, key, where);
+    if (m.channels() != 1 || m.rows != M::rows || m.cols != M::cols)
+        CV_Error(Error::StsBadSize, where + cv::format(": key '%s' must be a %dx%d matrix, got "
+                 "%dx%d with %d channel(s)", key, M::rows, M::cols, m.rows, m.cols, m.channels()));
+    if (m.depth() != CV_64F && m.depth() != CV_32F)
+        CV_Error(Error::StsUnsupportedFormat, where + ": key '" + key + "' must be a floating "
+                 "point matrix");
+    Mat md;
+    m.convertTo(md, CV_64F);
+    return M(md.ptr<double>());
+}
+
+String tmpNameFor(const String& path)
+{
+    fs::path p(path);
+    // Keep the extension so that FileStorage / imwrite pick the same format.
+    String stem = p.filename().string();
+    String ext;
+    const String gz = ".gz";
+    if (stem.size() > gz.size() && stem.compare(stem.size() - gz.size(), gz.size(), gz) == 0)
+    {
+        fs::path inner(stem.substr(0, stem.size() - gz.size()));
+        ext = inner.extension().string() + gz;
+        stem = inner.stem().string();
+    }
+    else
+    {
+        ext = p.extension().string();
+        stem = p.stem().string();
+    }
+    fs::path dir = p.parent_path();
+    String name = "." + stem + cv::format(".tmp%d", (int)cv::getTickCount() & 0xffff) + ext;
+    return (dir / name).string();
+}
+
+} // namespace
+
+void writeAtomically(const String& path, const std::function<void(const String& tmpPath)>& writer)
+{
+    const String tmp = tmpNameFor(path);
+    try
+    {
+        writer(tmp);
+        std::error_code ec;
+        if (fs::is_directory(path) && fs::is_directory(tmp))
+            fs::remove_all(path, ec);
+        fs::rename(tmp, path, ec);
+        if (ec)
+            CV_Error(Error::StsError, path + ": cannot rename from " + tmp + ": " + ec.message());
+    }
+    catch (...)
+    {
+        std::error_code ec;
+        fs::remove_all(tmp, ec);
+        throw;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tracks
+
+bool Tracks::observed(int f, int p) const
+{
+    return isFinite2(tracks.at<Point2f>(f, p));
+}
+
+int Tracks::observationCount(int p) const
+{
+    int n = 0;
+    for (int f = 0; f < tracks.rows; f++)
+        n += observed(f, p) ? 1 : 0;
+    return n;
+}
+
+void Tracks::validate(const String& what) const
+{
+    const String where = what.empty() ? String("tracks") : what;
+    if (imageSize.width <= 0 || imageSize.height <= 0)
+        CV_Error(Error::StsBadArg, where + ": image_size must be positive");
+    if (tracks.empty())
+        CV_Error(Error::StsBadSize, where + ": key 'tracks' is empty");
+    if (tracks.type() != CV_32FC2)
+        CV_Error(Error::StsUnsupportedFormat, where + ": key 'tracks' must be a CV_32FC2 (2f) "
+                 "matrix, got " + typeToString(tracks.type()));
+    for (int f = 0; f < tracks.rows; f++)
+    {
+        const Point2f* row = tracks.ptr<Point2f>(f);
+        for (int p = 0; p < tracks.cols; p++)
+        {
+            const bool fx = std::isfinite(row[p].x), fy = std::isfinite(row[p].y);
+            if (fx != fy)
+                CV_Error(Error::StsBadArg, where + cv::format(": key 'tracks' (%d, %d) has one "
+                         "coordinate NaN and the other not", f, p));
+        }
+    }
+}
+
+Tracks readTracks(const String& path)
+{
+    FileStorage storage = openForRead(path);
+    FileNode root = storage.root();
+    Tracks t;
+    t.imageSize = readImageSize(root, path);
+    const int frames = readIntKey(root, "frames", path);
+    const int points = readIntKey(root, "points", path);
+    t.tracks = readMatKey(root, "tracks", path);
+    if (t.tracks.type() != CV_32FC2)
+    {
+        if (t.tracks.channels() == 2 && t.tracks.depth() == CV_64F)
+            t.tracks.convertTo(t.tracks, CV_32FC2);
+        else
+            CV_Error(Error::StsUnsupportedFormat, path + ": key 'tracks' must be a 2f "
+                     "(CV_32FC2) matrix, got " + typeToString(t.tracks.type()));
+    }
+    if (t.tracks.rows != frames || t.tracks.cols != points)
+        CV_Error(Error::StsBadSize, path + cv::format(": key 'tracks' is %dx%d but frames = %d "
+                 "and points = %d", t.tracks.rows, t.tracks.cols, frames, points));
+    t.validate(path);
+    return t;
+}
+
+void writeTracks(const String& path, const Tracks& tracks)
+{
+    tracks.validate(path);
+    writeAtomically(path, [&](const String& tmp) {
+        FileStorage storage(tmp, FileStorage::WRITE);
+        if (!storage.isOpened())
+            CV_Error(Error::StsError, path + ": cannot open for writing");
+        storage << "image_size" << (Mat_<int>(1, 2) << tracks.imageSize.width,
+                                    tracks.imageSize.height);
+        storage << "frames" << tracks.frames();
+        storage << "points" << tracks.points();
+        storage << "tracks" << tracks.tracks;
+        storage.release();
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reconstruction
+
+int Reconstruction::findCamera(int frame) const
+{
+    auto it = std::lower_bound(cameras.begin(), cameras.end(), frame,
+                               [](const Camera& c, int f) { return c.frame < f; });
+    if (it != cameras.end() && it->frame == frame)
+        return (int)(it - cameras.begin());
+    return -1;
+}
+
+const Camera& Reconstruction::camera(int frame) const
+{
+    const int i = findCamera(frame);
+    if (i < 0)
+        CV_Error(Error::StsObjectNotFound, cv::format("the reconstruction has no camera for "
+                 "frame %d", frame));
+    return cameras[i];
+}
+
+int Reconstruction::validPointCount() const
+{
+    int n = 0;
+    for (int i = 0; i < points.rows; i++)
+    {
+        const double* p = points.ptr<double>(i);
+        n += (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) ? 1 : 0;
+    }
+    return n;
+}
+
+void Reconstruction::validate(const String& what) const
+{
+    const String where = what.empty() ? String("reconstruction") : what;
+    if (imageSize.width <= 0 || imageSize.height <= 0)
+        CV_Error(Error::StsBadArg, where + ": image_size must be positive");
+    if (cameras.empty())
+        CV_Error(Error::StsBadSize, where + ": key 'cameras' holds no camera");
+    for (size_t i = 0; i < cameras.size(); i++)
+    {
+        const String ci = where + cv::format(": cameras[%d]", (int)i);
+        if (cameras[i].model != model)
+            CV_Error(Error::StsBadArg, ci + ": camera model differs from the file's 'model'");
+        if (cameras[i].frame < 0)
+            CV_Error(Error::StsBadArg, ci + ": key 'frame' must be >= 0");
+        if (i > 0 && cameras[i].frame <= cameras[i - 1].frame)
+            CV_Error(Error::StsBadArg, ci + cv::format(": frame %d is not after the previous "
+                     "camera's frame %d (cameras must be in increasing frame order)",
+                     cameras[i].frame, cameras[i - 1].frame));
+        cameras[i].validate(ci);
+    }
+    if (!points.empty())
+    {
+        if (points.type() != CV_64FC1 || points.cols != 3)
+            CV_Error(Error::StsBadSize, where + ": key 'points' must be a P x 3 double matrix, "
+                     "got " + cv::format("%dx%d ", points.rows, points.cols) +
+                     typeToString(points.type()));
+    }
+}
+
+Reconstruction readReconstruction(const String& path)
+{
+    FileStorage storage = openForRead(path);
+    FileNode root = storage.root();
+    Reconstruction rec;
+    FileNode modelNode = requireKey(root, "model", path);
+    if (!modelNode.isString())
+        CV_Error(Error::StsParseError, path + ": key 'model' must be a string");
+    try
+    {
+        rec.model = parseCameraModel((String)modelNode);
+    }
+    catch (const cv::Exception& e)
+    {
+        CV_Error(Error::StsBadArg, path + ": key 'model': " + e.err);
+    }
+    rec.imageSize = readImageSize(root, path);
+    FileNode cams = requireKey(root, "cameras", path);
+    if (!cams.isSeq())
+        CV_Error(Error::StsParseError, path + ": key 'cameras' must be a sequence of maps");
+    int i = 0;
+    for (FileNodeIterator it = cams.begin(); it != cams.end(); ++it, ++i)
+    {
+        const String ci = path + cv::format(": cameras[%d]", i);
+        FileNode c = *it;
+        if (!c.isMap())
+            CV_Error(Error::StsParseError, ci + " is not a map");
+        Camera cam;
+        cam.model = rec.model;
+        cam.frame = readIntKey(c, "frame", ci);
+        cam.R = readFixedMat<Matx33d>(c, "R", ci);
+        {
+            const Matx31d tt = readFixedMat<Matx31d>(c, "t", ci);
+            cam.t = Vec3d(tt(0), tt(1), tt(2));
+        }
+        if (rec.model == SCALED_ORTHOGRAPHIC)
+        {
+            cam.s = readRealKey(c, "s", ci);
+            Matx12d pp = readFixedMat<Matx12d>(c, "principal_point", ci);
+            cam.pp = Point2d(pp(0), pp(1));
+        }
+        else
+        {
+            cam.K = readFixedMat<Matx33d>(c, "K", ci);
+            cam.pp = Point2d(cam.K(0, 2), cam.K(1, 2));
+            if (!c["principal_point"].empty())
+            {
+                Matx12d pp = readFixedMat<Matx12d>(c, "principal_point", ci);
+                if (std::abs(pp(0) - cam.K(0, 2)) > 1e-6 || std::abs(pp(1) - cam.K(1, 2)) > 1e-6)
+                    CV_Error(Error::StsBadArg, ci + ": key 'principal_point' differs from K");
+            }
+        }
+        rec.cameras.push_back(cam);
+    }
+    FileNode pts = root["points"];
+    if (!pts.empty() && !pts.isNone())
+    {
+        Mat P = readMatKey(root, "points", path);
+        if (!P.empty())
+        {
+            if (P.channels() != 1 || P.cols != 3)
+                CV_Error(Error::StsBadSize, path + cv::format(": key 'points' must be P x 3, got "
+                         "%dx%d with %d channel(s)", P.rows, P.cols, P.channels()));
+            if (P.depth() != CV_64F && P.depth() != CV_32F)
+                CV_Error(Error::StsUnsupportedFormat, path + ": key 'points' must be a double "
+                         "matrix");
+            P.convertTo(rec.points, CV_64F);
+        }
+    }
+    rec.validate(path);
+    return rec;
+}
+
+void writeReconstruction(const String& path, const Reconstruction& rec)
+{
+    rec.validate(path);
+    writeAtomically(path, [&](const String& tmp) {
+        FileStorage storage(tmp, FileStorage::WRITE);
+        if (!storage.isOpened())
+            CV_Error(Error::StsError, path + ": cannot open for writing");
+        storage << "model" << cameraModelName(rec.model);
+        storage << "image_size" << (Mat_<int>(1, 2) << rec.imageSize.width,
+                                    rec.imageSize.height);
+        storage << "cameras" << "[";
+        for (const Camera& c : rec.cameras)
+        {
+            storage << "{";
+            storage << "frame" << c.frame;
+            storage << "R" << Mat(c.R);
+            storage << "t" << Mat(c.t);
+            const Point2d pp = c.principalPoint();
+            if (rec.model == SCALED_ORTHOGRAPHIC)
+                storage << "s" << c.s;
+            else
+                storage << "K" << Mat(c.K);
+            storage << "principal_point" << (Mat_<double>(1, 2) << pp.x, pp.y);
+            storage << "}";
+        }
+        storage << "]";
+        storage << "points" << (rec.points.empty() ? Mat(0, 3, CV_64F) : rec.points);
+        storage.release();
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Masks
+
+ObjectMasks readMasks(const String& dir, Size expectedSize)
+{
+    if (!fs::is_directory(dir))
+        CV_Error(Error::StsObjectNotFound, dir + ": masks folder not found");
+    ObjectMasks out;
+    std::vector<fs::path> objects;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.is_directory())
+            objects.push_back(e.path());
+    std::sort(objects.begin(), objects.end());
+    for (const fs::path& obj : objects)
+    {
+        const String name = obj.filename().string();
+        if (name.empty() || name[0] == '.')
+            continue;
+        FrameMasks frames;
+        std::vector<fs::path> files;
+        for (const auto& e : fs::directory_iterator(obj))
+            if (e.is_regular_file())
+                files.push_back(e.path());
+        std::sort(files.begin(), files.end());
+        for (const fs::path& f : files)
+        {
+            const String fname = f.filename().string();
+            if (f.extension() != ".png" || fname[0] == '.')
+                continue;
+            int index = -1;
+            char tail = 0;
+            if (std::sscanf(f.stem().string().c_str(), "%d%c", &index, &tail) != 1 || index < 0)
+                CV_Error(Error::StsBadArg, f.string() + ": mask file name must be a frame "
+                         "index such as 0042.png");
+            Mat m = cv::imread(f.string(), IMREAD_GRAYSCALE);
+            if (m.empty())
+                CV_Error(Error::StsParseError, f.string() + ": cannot read image (missing or "
+                         "corrupt)");
+            if (!expectedSize.empty() && m.size() != expectedSize)
+                CV_Error(Error::StsBadSize, f.string() + cv::format(": mask is %dx%d but the "
+                         "frames are %dx%d", m.cols, m.rows, expectedSize.width,
+                         expectedSize.height));
+            cv::threshold(m, m, 127, 255, THRESH_BINARY);
+            if (frames.count(index))
+                CV_Error(Error::StsBadArg, f.string() + cv::format(": a second mask for frame %d",
+                         index));
+            frames[index] = m;
+        }
+        if (!frames.empty())
+            out[name] = frames;
+    }
+    if (out.empty())
+        CV_Error(Error::StsBadArg, dir + ": holds no <object>/<frame>.png mask");
+    return out;
+}
+
+void writeMasks(const String& dir, const ObjectMasks& masks)
+{
+    fs::path target(dir);
+    if (target.has_parent_path())
+        fs::create_directories(target.parent_path());
+    writeAtomically(dir, [&](const String& tmp) {
+        fs::create_directories(tmp);
+        for (const auto& obj : masks)
+        {
+            if (obj.first.empty() || obj.first.find('/') != String::npos)
+                CV_Error(Error::StsBadArg, "invalid object name '" + obj.first + "'");
+            fs::path od = fs::path(tmp) / obj.first;
+            fs::create_directories(od);
+            for (const auto& fm : obj.second)
+            {
+                CV_CheckTypeEQ(fm.second.type(), CV_8UC1, "masks must be 8-bit single channel");
+                const String file = (od / cv::format("%04d.png", fm.first)).string();
+                if (!cv::imwrite(file, fm.second))
+                    CV_Error(Error::StsError, dir + ": cannot write " + file);
+            }
+        }
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Frame sources
+
+FrameSource::~FrameSource() {}
+
+namespace {
+
+class ImageListSource CV_FINAL : public FrameSource
+{
+public:
+    ImageListSource(const String& input, std::vector<String> files)
+        : input_(input), files_(std::move(files))
+    {
+        Mat first = cv::imread(files_[0], IMREAD_COLOR);
+        if (first.empty())
+            CV_Error(Error::StsParseError, files_[0] + ": cannot read image (corrupt or not an "
+                     "image)");
+        size_ = first.size();
+    }
+    int count() const CV_OVERRIDE { return (int)files_.size(); }
+    Size size() const CV_OVERRIDE { return size_; }
+    double fps() const CV_OVERRIDE { return 25.0; }
+    int position() const CV_OVERRIDE { return pos_; }
+    void seek(int index) CV_OVERRIDE
+    {
+        CV_CheckGE(index, 0, "seek index");
+        CV_CheckLE(index, count(), "seek index");
+        pos_ = index;
+    }
+    bool read(OutputArray frame) CV_OVERRIDE
+    {
+        if (pos_ >= (int)files_.size())
+            return false;
+        Mat m = cv::imread(files_[pos_], IMREAD_COLOR);
+        if (m.empty())
+            CV_Error(Error::StsParseError, files_[pos_] + ": cannot read image (corrupt?)");
+        if (m.size() != size_)
+            CV_Error(Error::StsBadSize, files_[pos_] + cv::format(": image is %dx%d, the first "
+                     "frame is %dx%d", m.cols, m.rows, size_.width, size_.height));
+        m.copyTo(frame);
+        pos_++;
+        return true;
+    }
+
+private:
+    String input_;
+    std::vector<String> files_;
+    Size size_;
+    int pos_ = 0;
+};
+
+class VideoSource CV_FINAL : public FrameSource
+{
+public:
+    explicit VideoSource(const String& path) : path_(path)
+    {
+        open();
+        Mat first;
+        if (!cap_.read(first) || first.empty())
+            CV_Error(Error::StsParseError, path_ + ": cannot decode a frame (corrupt video or "
+                     "unsupported codec)");
+        size_ = first.size();
+        count_ = (int)cap_.get(CAP_PROP_FRAME_COUNT);
+        fps_ = cap_.get(CAP_PROP_FPS);
+        if (!(fps_ > 0 && fps_ < 1000))
+            fps_ = 25.0;
+        open();
+    }
+    int count() const CV_OVERRIDE { return count_; }
+    Size size() const CV_OVERRIDE { return size_; }
+    double fps() const CV_OVERRIDE { return fps_; }
+    int position() const CV_OVERRIDE { return pos_; }
+    void seek(int index) CV_OVERRIDE
+    {
+        CV_CheckGE(index, 0, "seek index");
+        if (index < pos_)
+            open();
+        Mat skip;
+        while (pos_ < index)
+        {
+            if (!cap_.grab())
+                CV_Error(Error::StsOutOfRange, path_ + cv::format(": cannot seek to frame %d, "
+                         "the video ends at %d", index, pos_));
+            pos_++;
+        }
+    }
+    bool read(OutputArray frame) CV_OVERRIDE
+    {
+        Mat m;
+        if (!cap_.read(m) || m.empty())
+            return false;
+        if (m.size() != size_)
+            CV_Error(Error::StsBadSize, path_ + cv::format(": frame %d is %dx%d, expected %dx%d",
+                     pos_, m.cols, m.rows, size_.width, size_.height));
+        if (m.type() != CV_8UC3)
+        {
+            if (m.channels() == 1)
+                cv::cvtColor(m, m, COLOR_GRAY2BGR);
+            else if (m.channels() == 4)
+                cv::cvtColor(m, m, COLOR_BGRA2BGR);
+        }
+        m.copyTo(frame);
+        pos_++;
+        return true;
+    }
+
+private:
+    void open()
+    {
+        cap_.release();
+        if (!cap_.open(path_, CAP_FFMPEG) && !cap_.open(path_, CAP_ANY))
+            CV_Error(Error::StsParseError, path_ + ": cannot open as a video (corrupt or "
+                     "unsupported format)");
+        pos_ = 0;
+    }
+
+    String path_;
+    VideoCapture cap_;
+    Size size_;
+    int count_ = 0;
+    double fps_ = 25.0;
+    int pos_ = 0;
+};
+
+bool isImageFile(const fs::path& p)
+{
+    String e = p.extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+    return e == ".png" || e == ".jpg" || e == ".jpeg" || e == ".bmp" || e == ".tif" ||
+           e == ".tiff" || e == ".pgm" || e == ".ppm" || e == ".exr" || e == ".webp";
+}
+
+} // namespace
+
+Ptr<FrameSource> FrameSource::open(const String& input)
+{
+    if (input.empty())
+        CV_Error(Error::StsBadArg, "no input given");
+    if (fs::is_directory(input))
+    {
+        std::vector<String> files;
+        for (const auto& e : fs::directory_iterator(input))
+            if (e.is_regular_file() && isImageFile(e.path()) &&
+                e.path().filename().string()[0] != '.')
+                files.push_back(e.path().string());
+        std::sort(files.begin(), files.end());
+        if (files.empty())
+            CV_Error(Error::StsObjectNotFound, input + ": folder holds no image");
+        return makePtr<ImageListSource>(input, files);
+    }
+    if (input.find('%') != String::npos)
+    {
+        std::vector<String> files;
+        for (int i = 0;; i++)
+        {
+            const String f = cv::format(input.c_str(), i);
+            if (!fs::exists(f))
+            {
+                if (i == 0)
+                {
+                    // Patterns may start at 1 (ffmpeg's default).
+                    const String f1 = cv::format(input.c_str(), 1);
+                    if (fs::exists(f1))
+                        continue;
+                }
+                break;
+            }
+            files.push_back(f);
+        }
+        if (files.empty())
+            CV_Error(Error::StsObjectNotFound, input + ": pattern matches no file");
+        return makePtr<ImageListSource>(input, files);
+    }
+    if (!fs::exists(input))
+        CV_Error(Error::StsObjectNotFound, input + ": input not found");
+    if (isImageFile(fs::path(input)))
+        return makePtr<ImageListSource>(input, std::vector<String>{input});
+    return makePtr<VideoSource>(input);
+}
+
+} // namespace augocc
+} // namespace cv

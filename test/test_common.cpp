@@ -1,0 +1,92 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#include "test_precomp.hpp"
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <sys/wait.h>
+
+namespace opencv_test {
+
+testing::AssertionResult matNear(const char* expr1, const char* expr2, const char* /*exprEps*/,
+                                 cv::InputArray a_, cv::InputArray b_, double eps)
+{
+    cv::Mat a = a_.getMat(), b = b_.getMat();
+    if (a.size() != b.size() || a.type() != b.type())
+        return testing::AssertionFailure()
+               << expr1 << " and " << expr2 << " differ in size or type: " << a.size() << " "
+               << cv::typeToString(a.type()) << " vs " << b.size() << " "
+               << cv::typeToString(b.type());
+    if (a.empty())
+        return testing::AssertionSuccess();
+    cv::Mat diff;
+    cv::absdiff(a.reshape(1), b.reshape(1), diff);
+    double maxVal = 0;
+    cv::Point maxLoc;
+    cv::minMaxLoc(diff, nullptr, &maxVal, nullptr, &maxLoc);
+    if (maxVal <= eps)
+        return testing::AssertionSuccess();
+    return testing::AssertionFailure() << expr1 << " and " << expr2 << " differ by " << maxVal
+                                       << " > " << eps << " at (row " << maxLoc.y << ", col "
+                                       << maxLoc.x << ")";
+}
+
+std::string sharedDataPath(const std::string& relative)
+{
+    const char* env = std::getenv("AUGOCC_SHARED_DATA");
+    std::filesystem::path base = env ? env : AUGOCC_SHARED_DATA_PATH;
+    std::filesystem::path p = base / relative;
+    return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+std::string tempDir(const std::string& tag)
+{
+    const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = tag;
+    if (info)
+        name = std::string(info->test_suite_name()) + "." + info->name() + "." + tag;
+    for (char& c : name)
+        if (c == '/')
+            c = '_';
+    std::filesystem::path p = std::filesystem::temp_directory_path() / "augocc_test" / name;
+    std::filesystem::remove_all(p);
+    std::filesystem::create_directories(p);
+    return p.string();
+}
+
+std::string augoccBinary()
+{
+    const char* env = std::getenv("AUGOCC_BIN");
+    return env ? std::string(env) : std::string(AUGOCC_BINARY_DIR) + "/bin/augocc";
+}
+
+int runCommand(const std::string& cmd, std::string* output)
+{
+    std::string full = cmd + " 2>&1";
+    FILE* pipe = popen(full.c_str(), "r");
+    if (!pipe)
+        return -1;
+    std::array<char, 4096> buf;
+    std::string out;
+    size_t n;
+    while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0)
+        out.append(buf.data(), n);
+    const int status = pclose(pipe);
+    if (output)
+        *output = out;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+double maskIoU(const cv::Mat& a, const cv::Mat& b)
+{
+    CV_Assert(a.size() == b.size());
+    cv::Mat ia = a > 0, ib = b > 0;
+    const double inter = cv::countNonZero(ia & ib);
+    const double uni = cv::countNonZero(ia | ib);
+    return uni > 0 ? inter / uni : 1.0;
+}
+
+} // namespace opencv_test

@@ -1,0 +1,41 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#ifndef OPENCV_AUGOCC_TEST_COMMON_HPP
+#define OPENCV_AUGOCC_TEST_COMMON_HPP
+
+#include <string>
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+namespace opencv_test {
+
+//! Compares two matrices element-wise with NORM_INF, reporting size/type mismatch and the worst
+//! element.
+testing::AssertionResult matNear(const char* expr1, const char* expr2, const char* exprEps,
+                                 cv::InputArray a, cv::InputArray b, double eps);
+#define EXPECT_MAT_NEAR(a, b, eps) EXPECT_PRED_FORMAT3(opencv_test::matNear, a, b, eps)
+#define ASSERT_MAT_NEAR(a, b, eps) ASSERT_PRED_FORMAT3(opencv_test::matNear, a, b, eps)
+
+//! Path of a data set in ../shared/data, or "" when absent (tests GTEST_SKIP then).
+std::string sharedDataPath(const std::string& relative);
+//! Skips the current test when ../shared/data/<relative> is absent.
+#define AUGOCC_REQUIRE_SHARED_DATA(var, relative)                                     \
+    const std::string var = opencv_test::sharedDataPath(relative);                    \
+    if (var.empty())                                                                  \
+        GTEST_SKIP() << "shared data " << relative << " absent (../shared/data)"
+
+//! A fresh empty temporary folder for the current test, removed by the caller if wanted.
+std::string tempDir(const std::string& tag);
+
+//! Path of the built augocc binary.
+std::string augoccBinary();
+//! Runs a shell command, returns its exit status; stdout+stderr are captured into *output.
+int runCommand(const std::string& cmd, std::string* output = nullptr);
+
+//! Intersection over union of two binary masks (> 0 = in).
+double maskIoU(const cv::Mat& a, const cv::Mat& b);
+
+} // namespace opencv_test
+
+#endif
