@@ -1,4 +1,4 @@
-// augocc synth: placeholder until the SceneSynthesizer lands.
+// augocc synth: placeholder until its stage lands (exit 2, "not implemented yet").
 
 #include "cli_common.hpp"
 
@@ -6,7 +6,8 @@ namespace augocc_cli {
 
 void registerSynth(CLI::App& app, Globals&)
 {
-    CLI::App* sub = app.add_subcommand("synth", "write a synthesized data set");
+    CLI::App* sub = app.add_subcommand("synth", "(not implemented yet)");
+    sub->allow_extras();
     sub->callback([]() { throw UsageError("synth: not implemented yet"); });
 }
 

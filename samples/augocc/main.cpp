@@ -19,6 +19,15 @@ int main(int argc, char** argv)
     app.add_flag("--quiet,-q", g.quiet, "print nothing but errors");
     // Sub-commands, in pipeline order (one cmd_<name>.cpp each).
     registerSynth(app, g);
+    registerTrack(app, g);
+    registerSfm(app, g);
+    registerClone(app, g);
+    registerMatte(app, g);
+    registerComposite(app, g);
+    registerRun(app, g);
+    registerDemo(app, g);
+    registerAnnotate(app, g);
+    registerPropagate(app, g);
 
     try
     {

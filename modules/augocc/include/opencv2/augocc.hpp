@@ -14,5 +14,13 @@ the real objects, and compositing by depth test.
 
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/mesh.hpp"
+#include "opencv2/augocc/scene_synthesizer.hpp"
+#include "opencv2/augocc/feature_tracker.hpp"
+#include "opencv2/augocc/factorization_sfm.hpp"
+#include "opencv2/augocc/camera_refiner.hpp"
+#include "opencv2/augocc/clone_builder.hpp"
+#include "opencv2/augocc/compositor.hpp"
+#include "opencv2/augocc/silhouette_editor.hpp"
 
 #endif

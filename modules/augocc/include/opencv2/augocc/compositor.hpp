@@ -1,0 +1,9 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#ifndef OPENCV_AUGOCC_COMPOSITOR_HPP
+#define OPENCV_AUGOCC_COMPOSITOR_HPP
+
+#include <opencv2/core.hpp>
+
+#endif

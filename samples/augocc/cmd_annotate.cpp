@@ -1,0 +1,14 @@
+// augocc annotate: placeholder until its stage lands (exit 2, "not implemented yet").
+
+#include "cli_common.hpp"
+
+namespace augocc_cli {
+
+void registerAnnotate(CLI::App& app, Globals&)
+{
+    CLI::App* sub = app.add_subcommand("annotate", "(not implemented yet)");
+    sub->allow_extras();
+    sub->callback([]() { throw UsageError("annotate: not implemented yet"); });
+}
+
+} // namespace augocc_cli

@@ -1,0 +1,14 @@
+// augocc composite: placeholder until its stage lands (exit 2, "not implemented yet").
+
+#include "cli_common.hpp"
+
+namespace augocc_cli {
+
+void registerComposite(CLI::App& app, Globals&)
+{
+    CLI::App* sub = app.add_subcommand("composite", "(not implemented yet)");
+    sub->allow_extras();
+    sub->callback([]() { throw UsageError("composite: not implemented yet"); });
+}
+
+} // namespace augocc_cli

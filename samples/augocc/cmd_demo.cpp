@@ -1,0 +1,14 @@
+// augocc demo: placeholder until its stage lands (exit 2, "not implemented yet").
+
+#include "cli_common.hpp"
+
+namespace augocc_cli {
+
+void registerDemo(CLI::App& app, Globals&)
+{
+    CLI::App* sub = app.add_subcommand("demo", "(not implemented yet)");
+    sub->allow_extras();
+    sub->callback([]() { throw UsageError("demo: not implemented yet"); });
+}
+
+} // namespace augocc_cli

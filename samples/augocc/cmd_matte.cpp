@@ -1,0 +1,14 @@
+// augocc matte: placeholder until its stage lands (exit 2, "not implemented yet").
+
+#include "cli_common.hpp"
+
+namespace augocc_cli {
+
+void registerMatte(CLI::App& app, Globals&)
+{
+    CLI::App* sub = app.add_subcommand("matte", "(not implemented yet)");
+    sub->allow_extras();
+    sub->callback([]() { throw UsageError("matte: not implemented yet"); });
+}
+
+} // namespace augocc_cli

@@ -1,0 +1,14 @@
+// augocc propagate: placeholder until its stage lands (exit 2, "not implemented yet").
+
+#include "cli_common.hpp"
+
+namespace augocc_cli {
+
+void registerPropagate(CLI::App& app, Globals&)
+{
+    CLI::App* sub = app.add_subcommand("propagate", "(not implemented yet)");
+    sub->allow_extras();
+    sub->callback([]() { throw UsageError("propagate: not implemented yet"); });
+}
+
+} // namespace augocc_cli

@@ -1,0 +1,14 @@
+// augocc run: placeholder until its stage lands (exit 2, "not implemented yet").
+
+#include "cli_common.hpp"
+
+namespace augocc_cli {
+
+void registerRun(CLI::App& app, Globals&)
+{
+    CLI::App* sub = app.add_subcommand("run", "(not implemented yet)");
+    sub->allow_extras();
+    sub->callback([]() { throw UsageError("run: not implemented yet"); });
+}
+
+} // namespace augocc_cli

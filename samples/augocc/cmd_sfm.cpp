@@ -1,0 +1,14 @@
+// augocc sfm: placeholder until its stage lands (exit 2, "not implemented yet").
+
+#include "cli_common.hpp"
+
+namespace augocc_cli {
+
+void registerSfm(CLI::App& app, Globals&)
+{
+    CLI::App* sub = app.add_subcommand("sfm", "(not implemented yet)");
+    sub->allow_extras();
+    sub->callback([]() { throw UsageError("sfm: not implemented yet"); });
+}
+
+} // namespace augocc_cli
