@@ -58,6 +58,15 @@ struct CV_EXPORTS Mesh
     static Mesh dome(float radius, int segments = 32, int rings = 12);
 };
 
+/** @brief Writes a mesh as binary little-endian PLY (vertices, faces, per-vertex colours and normals
+when present). A mesh with no faces is written as a point cloud. Atomic (temporary + rename). */
+CV_EXPORTS void writeMeshPly(const String& path, const Mesh& mesh);
+
+/** @brief Loads every mesh of a file through Assimp (OBJ, PLY, glTF/GLB, and the other formats
+Assimp reads), with materials (diffuse and ambient colour, diffuse texture) and node transforms
+applied. Throws StsParseError naming the file when it does not parse or holds no triangle. */
+CV_EXPORTS std::vector<Mesh> loadMeshes(const String& path);
+
 //! @}
 
 } // namespace augocc
