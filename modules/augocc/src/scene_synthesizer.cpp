@@ -73,27 +73,45 @@ uint64 mixSeed(uint64 seed, uint64 stream)
 // ---------------------------------------------------------------------------------------------
 // Procedural textures (deterministic from an RNG)
 
-// Multi-octave value noise in [0, 1], CV_32F.
+// Multi-octave value noise in [0, 1], CV_32F, periodic (tileable) over the image: each octave's
+// random grid is wrapped around before the cubic upsampling.
 Mat valueNoise(RNG& rng, Size size, double cellPx, int octaves)
 {
     Mat acc = Mat::zeros(size, CV_32F);
     double amp = 1.0, total = 0.0, cell = cellPx;
-    for (int o = 0; o < octaves; o++)
+    const int pad = 2;  // cells of wrap-around: covers the 4x4 cubic kernel
+    for (int o = 0; o < octaves && cell >= 2; o++)
     {
-        const int gw = std::max(2, (int)std::ceil(size.width / cell) + 1);
-        const int gh = std::max(2, (int)std::ceil(size.height / cell) + 1);
-        Mat grid(gh, gw, CV_32F), up;
+        const int gw = std::max(1, cvRound(size.width / cell));
+        const int gh = std::max(1, cvRound(size.height / cell));
+        const double sx = (double)size.width / gw, sy = (double)size.height / gh;
+        Mat grid(gh, gw, CV_32F), padded, up;
         rng.fill(grid, RNG::UNIFORM, 0.0, 1.0);
-        cv::resize(grid, up, size, 0, 0, INTER_CUBIC);
-        cv::scaleAdd(up, amp, acc, acc);
+        cv::copyMakeBorder(grid, padded, pad, pad, pad, pad, BORDER_WRAP);
+        const Size upSize(cvRound(padded.cols * sx), cvRound(padded.rows * sy));
+        cv::resize(padded, up, upSize, 0, 0, INTER_CUBIC);
+        const Rect roi(cvRound(pad * sx), cvRound(pad * sy), size.width, size.height);
+        cv::scaleAdd(up(roi), amp, acc, acc);
         total += amp;
         amp *= 0.55;
         cell *= 0.5;
-        if (cell < 2)
-            break;
     }
     acc *= 1.0 / total;
     return acc;
+}
+
+// Draws with wrap-around (so that a texture drawn this way tiles seamlessly) when `wrap`.
+template <typename DrawFn>
+void drawWrapped(Size size, bool wrap, DrawFn draw)
+{
+    if (!wrap)
+    {
+        draw(Point(0, 0));
+        return;
+    }
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++)
+            draw(Point(dx * size.width, dy * size.height));
 }
 
 Scalar randomColorNear(RNG& rng, const Vec3f& rgb, double spread)
@@ -128,14 +146,16 @@ Mat makeTexture(RNG& rng, Size size, const Vec3f& baseRgb, TextureStyle style)
     Mat tex;
     cv::merge(ch, tex);
     const double scale = size.width / 256.0;
+    const bool wrap = style == TEX_GROUND;  // the ground texture repeats: make it seamless
     // Blobs of a nearby colour.
     const int blobs = style == TEX_GROUND ? 60 : 25;
     for (int i = 0; i < blobs; i++)
     {
         const Point c(rng.uniform(0, size.width), rng.uniform(0, size.height));
         const int r = (int)(scale * rng.uniform(3, 18));
-        const Scalar col = randomColorNear(rng, baseRgb, 0.25);
-        cv::circle(tex, c, r, col, FILLED, LINE_AA);
+        const float shade = (float)rng.uniform(0.7, 1.25);
+        const Scalar col = randomColorNear(rng, baseRgb * shade, 0.08);
+        drawWrapped(size, wrap, [&](Point o) { cv::circle(tex, c + o, r, col, FILLED, LINE_AA); });
     }
     // Lines: cracks, joints, paths.
     const int lines = style == TEX_GROUND ? 30 : 14;
@@ -144,8 +164,9 @@ Mat makeTexture(RNG& rng, Size size, const Vec3f& baseRgb, TextureStyle style)
         const Point a(rng.uniform(0, size.width), rng.uniform(0, size.height));
         const Point b = a + Point(rng.uniform(-size.width / 3, size.width / 3),
                                   rng.uniform(-size.height / 3, size.height / 3));
-        const Scalar col = randomColorNear(rng, baseRgb * 0.5f, 0.15);
-        cv::line(tex, a, b, col, rng.uniform(1, 4), LINE_AA);
+        const Scalar col = randomColorNear(rng, baseRgb * 0.5f, 0.1);
+        const int thick = rng.uniform(1, 4);
+        drawWrapped(size, wrap, [&](Point o) { cv::line(tex, a + o, b + o, col, thick, LINE_AA); });
     }
     if (style == TEX_FACADE)
     {
@@ -185,10 +206,13 @@ Mat makeTexture(RNG& rng, Size size, const Vec3f& baseRgb, TextureStyle style)
         const Scalar col = dark ? randomColorNear(rng, baseRgb * 0.35f, 0.1)
                                 : randomColorNear(rng, Vec3f(0.95f, 0.93f, 0.88f), 0.05);
         const int r = rng.uniform(1, 4);
-        if (rng.uniform(0, 2) == 0)
-            cv::circle(tex, c, r, col, FILLED, LINE_AA);
-        else
-            cv::rectangle(tex, Rect(c.x, c.y, r + 1, r + 1), col, FILLED);
+        const bool round = rng.uniform(0, 2) == 0;
+        drawWrapped(size, wrap, [&](Point o) {
+            if (round)
+                cv::circle(tex, c + o, r, col, FILLED, LINE_AA);
+            else
+                cv::rectangle(tex, Rect(c.x + o.x, c.y + o.y, r + 1, r + 1), col, FILLED);
+        });
     }
     return tex;
 }
@@ -333,7 +357,7 @@ Material objectMaterial()
 
 Mesh makeBuilding(RNG& rng)
 {
-    Mesh m = Mesh::box(Vec3f(-2.2f, 0.f, 1.8f), Vec3f(0.8f, 3.2f, 3.8f));
+    Mesh m = Mesh::box(Vec3f(-0.8f, 0.f, 1.5f), Vec3f(2.2f, 3.2f, 3.5f));
     for (int face = 0; face < 6; face++)
         mapToTile(m, 4 * face, 4 * face + 4, face);
     const Vec3f wall(0.75f, 0.55f, 0.42f);  // brick
@@ -349,9 +373,11 @@ Mesh makeBuilding(RNG& rng)
 
 Mesh makeLBlock(RNG& rng)
 {
-    const std::vector<Point2f> fp = {Point2f(-4.6f, -2.8f), Point2f(-0.6f, -2.8f),
-                                     Point2f(-0.6f, -0.8f), Point2f(-2.6f, -0.8f),
-                                     Point2f(-2.6f, 1.4f),  Point2f(-4.6f, 1.4f)};
+    // Footprint (x, z): a back arm along x and a left arm towards the camera; the inner corner
+    // (the reflex vertex 3) faces the default camera.
+    const std::vector<Point2f> fp = {Point2f(-5.0f, -3.0f), Point2f(-0.5f, -3.0f),
+                                     Point2f(-0.5f, -1.0f), Point2f(-3.0f, -1.0f),
+                                     Point2f(-3.0f, 1.0f),  Point2f(-5.0f, 1.0f)};
     Mesh m = prism(fp, 2.4f, 3, 0);
     std::vector<std::pair<Vec3f, TextureStyle>> tiles;
     for (int i = 0; i < 6; i++)
@@ -370,10 +396,10 @@ Mesh makeTower(RNG& rng)
     appendInTile(m, Mesh::cylinder(0.55f, 0.f, 4.4f, 24), 0);
     appendInTile(m, Mesh::cylinder(1.7f, 4.4f, 5.5f, 40), 1);
     appendInTile(m, Mesh::cone(1.7f, 5.5f, 6.3f, 40), 2);
-    m.transform(translation(1.5, 0, -1.5));
+    m.transform(translation(2.8, 0, -1.8));
     std::vector<std::pair<Vec3f, TextureStyle>> tiles = {
         {Vec3f(0.85f, 0.82f, 0.7f), TEX_WALL},
-        {Vec3f(0.55f, 0.7f, 0.6f), TEX_FACADE},
+        {Vec3f(0.55f, 0.7f, 0.6f), TEX_WALL},
         {Vec3f(0.7f, 0.3f, 0.25f), TEX_ROOF}};
     m.material = objectMaterial();
     m.material.texture = makeAtlas(rng, tiles);
