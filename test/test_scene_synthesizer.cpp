@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <opencv2/video/tracking.hpp>
 
 namespace opencv_test {
 namespace {
@@ -27,6 +28,12 @@ const int kMaxSilhouetteTiePx = 10;
 // z^2 (far - near) / (far near 2^24) < 5e-5 units (perspective) here, and z is stored as float32
 // (~1e-5 at z = 200); 1e-3 leaves a 20x margin.
 const double kDepthTol = 1e-3;
+// Textures rich enough for KLT: Shi-Tomasi corners of frame 0 tracked by pyramidal Lucas-Kanade
+// into the next frame of the default orbit (0.85 degree apart) land within this median distance
+// of the true flow (from depth and the GT cameras). Measured 0.08 px (translation-only LK under
+// the small affine change of view and texture resampling); 0.15 px is about twice that.
+const double kMaxKltMedianErrPx = 0.15;
+const int kMinKltCorners = 300;  // of 500 requested, away from object outlines
 // Partial tracks cover at least 20% of the sequence (Params doc).
 const double kPartialMinFraction = 0.2;
 
@@ -298,6 +305,53 @@ TEST_P(Augocc_SceneSynthesizer_P, depth_matches_geometry)
         EXPECT_LE(maxGround, kDepthTol) << "frame " << f;
         EXPECT_LE(maxBox, kDepthTol) << "frame " << f;
     }
+}
+
+TEST_P(Augocc_SceneSynthesizer_P, textures_trackable)
+{
+    const CameraModel model = (CameraModel)GetParam();
+    // Consecutive frames of the default 60-frame orbit: 50 / 59 degrees apart.
+    SceneSynthesizer::Params p = smallParams(model);
+    p.frames = 2;
+    p.numKeyFrames = 2;
+    p.orbitDegrees = 50.0 / 59;
+    SyntheticScene s;
+    SceneSynthesizer::create(p)->synthesize(s);
+    const Camera& c0 = s.groundTruth.camera(0);
+    const Camera& c1 = s.groundTruth.camera(1);
+    Mat g0, g1;
+    cv::cvtColor(s.frames[0], g0, COLOR_BGR2GRAY);
+    cv::cvtColor(s.frames[1], g1, COLOR_BGR2GRAY);
+    // Corners away from label boundaries (occlusion edges move differently from either side).
+    Mat edges, keep;
+    cv::morphologyEx(s.labels[0], edges, MORPH_GRADIENT, Mat::ones(3, 3, CV_8U));
+    cv::compare(edges, 0, keep, CMP_EQ);
+    cv::erode(keep, keep, Mat::ones(9, 9, CV_8U));
+    std::vector<Point2f> p0, p1;
+    cv::goodFeaturesToTrack(g0, p0, 500, 0.01, 5, keep);
+    ASSERT_GE((int)p0.size(), kMinKltCorners) << "too few corners: textures too poor";
+    std::vector<uchar> status;
+    std::vector<float> err;
+    cv::calcOpticalFlowPyrLK(g0, g1, p0, p1, status, err, Size(21, 21), 3);
+    std::vector<double> errors;
+    for (size_t i = 0; i < p0.size(); i++)
+    {
+        if (!status[i])
+            continue;
+        // The corner's 3D point from the depth interpolated at its sub-pixel position (depth is
+        // planar per face, and the corners are away from edges).
+        Mat z;
+        cv::getRectSubPix(s.depth[0], Size(1, 1), p0[i], z);
+        const Vec3d X = c0.unproject(Point2d(p0[i]), z.at<float>(0, 0));
+        const Point2d expected = c1.project(X) + (Point2d(p0[i]) - c0.project(X));
+        errors.push_back(cv::norm(Point2d(p1[i]) - expected));
+    }
+    ASSERT_GE((int)errors.size(), kMinKltCorners);
+    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+    const double median = errors[errors.size() / 2];
+    std::cout << "[ MEASURE  ] " << cameraModelName(model) << ": " << p0.size()
+              << " corners, KLT frame 0 -> 1 median error " << median << " px" << std::endl;
+    EXPECT_LE(median, kMaxKltMedianErrPx);
 }
 
 INSTANTIATE_TEST_SUITE_P(/**/, Augocc_SceneSynthesizer_P,
