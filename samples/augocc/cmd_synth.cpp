@@ -100,14 +100,16 @@ void writeDepth(const fs::path& dir, const std::vector<Mat>& depth)
         fs << "scale" << scale;
         fs << "description" << "camera-space z = value / scale; 0 = nothing (infinite)";
     }
-    for (size_t f = 0; f < depth.size(); f++)
-    {
-        Mat z = depth[f].clone();
-        z.setTo(0, z == std::numeric_limits<float>::infinity());
-        Mat png;
-        z.convertTo(png, CV_16U, scale);
-        writeImage((dir / format("%04d.png", (int)f)).string(), png);
-    }
+    parallel_for_(Range(0, (int)depth.size()), [&](const Range& r) {
+        for (int f = r.start; f < r.end; f++)
+        {
+            Mat z = depth[f].clone();
+            z.setTo(0, z == std::numeric_limits<float>::infinity());
+            Mat png;
+            z.convertTo(png, CV_16U, scale);
+            writeImage((dir / format("%04d.png", f)).string(), png);
+        }
+    });
 }
 
 Mat contactSheet(const SyntheticScene& scene)
@@ -159,7 +161,17 @@ void runSynth(const Globals& g, const SynthOptions& o)
     }
     catch (const cv::Exception& e)
     {
-        throw UsageError("synth: " + e.err);
+        // Name the flag behind the rejected parameter.
+        static const std::pair<const char*, const char*> kFlags[] = {
+            {"frames", "--frames"}, {"imageSize", "--size"}, {"noiseSigma", "--noise"},
+            {"partialFraction", "--partial"}, {"outlierFraction", "--outliers"},
+            {"numTracks", "--tracks"}, {"numKeyFrames", "--key-frames"},
+            {"distanceRatio", "--distance-ratio"}};
+        std::string flag;
+        for (const auto& kv : kFlags)
+            if (e.err.find(std::string(kv.first) + " must") != std::string::npos)
+                flag = std::string(kv.second) + ": ";
+        throw UsageError("synth: " + flag + e.err);
     }
 
     info(g, "synthesizing " + std::to_string(p.frames) + " frames (" + o.model + ", seed " +
@@ -176,10 +188,23 @@ void runSynth(const Globals& g, const SynthOptions& o)
     writeAtomically(o.out, [&](const String& tmpPath) {
         const fs::path tmp(tmpPath);
         fs::create_directories(tmp / "frames");
-        for (size_t f = 0; f < scene.frames.size(); f++)
+        fs::create_directories(tmp / "gt" / "labels");
+        // PNG encoding dominates: frames and labels in parallel (each chunk its own files).
+        const int F = (int)scene.frames.size();
+        const int chunk = 8;
+        for (int start = 0; start < F; start += chunk)
         {
-            writeImage((tmp / "frames" / format("%04d.png", (int)f)).string(), scene.frames[f]);
-            progress.update((int)f + 1);
+            const int end = std::min(F, start + chunk);
+            parallel_for_(Range(start, end), [&](const Range& r) {
+                for (int f = r.start; f < r.end; f++)
+                {
+                    writeImage((tmp / "frames" / format("%04d.png", f)).string(),
+                               scene.frames[f]);
+                    writeImage((tmp / "gt" / "labels" / format("%04d.png", f)).string(),
+                               scene.labels[f]);
+                }
+            });
+            progress.update(end);
         }
         writeVideo((tmp / "video.mp4").string(), scene.frames);
         fs::create_directories(tmp / "input");
@@ -191,10 +216,6 @@ void runSynth(const Globals& g, const SynthOptions& o)
         writeTracks((tmp / "tracks.yml").string(), scene.tracks);
         writeTracks((tmp / "gt" / "clean_tracks.yml").string(), scene.cleanTracks);
         writeDepth(tmp / "gt" / "depth", scene.depth);
-        fs::create_directories(tmp / "gt" / "labels");
-        for (size_t f = 0; f < scene.labels.size(); f++)
-            writeImage((tmp / "gt" / "labels" / format("%04d.png", (int)f)).string(),
-                       scene.labels[f]);
         fs::create_directories(tmp / "gt" / "meshes");
         for (size_t i = 0; i < scene.objectNames.size(); i++)
             writeMeshPly((tmp / "gt" / "meshes" / (scene.objectNames[i] + ".ply")).string(),
