@@ -374,6 +374,7 @@ TEST(Augocc_SceneSynthesizer, can_create_default)
     EXPECT_EQ(p.outlierFraction, 0.0);
     EXPECT_EQ(p.numKeyFrames, 6);
     EXPECT_EQ(p.seed, (uint64)1);
+    EXPECT_EQ(p.frameSupersample, 1);
     const std::vector<String> names = s->getObjectNames();
     ASSERT_EQ(names.size(), (size_t)3);
     EXPECT_EQ(names[0], "building");
@@ -415,6 +416,8 @@ TEST(Augocc_SceneSynthesizer, bad_arg)
         [](SceneSynthesizer::Params& p) { p.outlierFraction = std::nan(""); },
         [](SceneSynthesizer::Params& p) { p.numKeyFrames = 1; },
         [](SceneSynthesizer::Params& p) { p.numKeyFrames = p.frames + 1; },
+        [](SceneSynthesizer::Params& p) { p.frameSupersample = 0; },
+        [](SceneSynthesizer::Params& p) { p.frameSupersample = 9; },
     };
     for (size_t i = 0; i < breakers.size(); i++)
     {
@@ -526,6 +529,35 @@ TEST(Augocc_SceneSynthesizer, render_frame_and_virtual)
     cv::absdiff(ss, withBox, d);
     EXPECT_LT(cv::mean(d)[0] + cv::mean(d)[1] + cv::mean(d)[2], 3 * 12.0)
         << "mean colour difference from the aliased render (textures are averaged too)";
+}
+
+TEST(Augocc_SceneSynthesizer, anti_aliased_frames)
+{
+    SceneSynthesizer::Params p = smallParams(PERSPECTIVE);
+    p.frames = 3;
+    p.numKeyFrames = 2;
+    SyntheticScene aliased, smooth;
+    SceneSynthesizer::create(p)->synthesize(aliased);
+    p.frameSupersample = 3;
+    Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(p);
+    synth->synthesize(smooth);
+    for (int f = 0; f < p.frames; f++)
+    {
+        // Ground truth sampled at pixel centres whatever the frames' supersampling.
+        EXPECT_EQ(cv::norm(aliased.labels[f], smooth.labels[f], NORM_INF), 0);
+        EXPECT_EQ(cv::norm(aliased.depth[f], smooth.depth[f], NORM_INF), 0);
+        // The same picture, edges and textures averaged over the pixel: close on average, and
+        // not identical.
+        const double meanDiff = cv::norm(aliased.frames[f], smooth.frames[f], NORM_L1) /
+                                (double)aliased.frames[f].total() / 3;
+        EXPECT_GT(meanDiff, 0.1);
+        EXPECT_LT(meanDiff, 10.0);
+    }
+    Mat img;
+    synth->renderWithVirtual(1, {}, img, 3);
+    EXPECT_EQ(cv::norm(img, smooth.frames[1], NORM_INF), 0);
+    synth->renderFrame(2, img);
+    EXPECT_EQ(cv::norm(img, smooth.frames[2], NORM_INF), 0);
 }
 
 TEST(Augocc_SceneSynthesizer, synth_command_end_to_end)

@@ -31,6 +31,7 @@ struct SynthOptions
     int tracks = 600;
     int keyFrames = 6;
     double distanceRatio = 10.0;
+    int supersample = 1;
     std::string contactSheet;
 };
 
@@ -154,6 +155,7 @@ void runSynth(const Globals& g, const SynthOptions& o)
     p.numTracks = o.tracks;
     p.numKeyFrames = o.keyFrames;
     p.distanceRatio = o.distanceRatio;
+    p.frameSupersample = o.supersample;
     Ptr<SceneSynthesizer> synth;
     try
     {
@@ -166,7 +168,7 @@ void runSynth(const Globals& g, const SynthOptions& o)
             {"frames", "--frames"}, {"imageSize", "--size"}, {"noiseSigma", "--noise"},
             {"partialFraction", "--partial"}, {"outlierFraction", "--outliers"},
             {"numTracks", "--tracks"}, {"numKeyFrames", "--key-frames"},
-            {"distanceRatio", "--distance-ratio"}};
+            {"distanceRatio", "--distance-ratio"}, {"frameSupersample", "--supersample"}};
         std::string flag;
         for (const auto& kv : kFlags)
             if (e.err.find(std::string(kv.first) + " must") != std::string::npos)
@@ -228,6 +230,7 @@ void runSynth(const Globals& g, const SynthOptions& o)
         fs << "partial_fraction" << p.partialFraction;
         fs << "outlier_fraction" << p.outlierFraction;
         fs << "distance_ratio" << p.distanceRatio;
+        fs << "frame_supersample" << p.frameSupersample;
         fs << "objects" << "[";
         for (const String& name : scene.objectNames)
             fs << name;
@@ -273,6 +276,9 @@ void registerSynth(CLI::App& app, Globals& g)
         ->capture_default_str();
     sub->add_option("--distance-ratio", o->distanceRatio,
                     "perspective: camera distance / scene size")->capture_default_str();
+    sub->add_option("--supersample", o->supersample,
+                    "render frames K x K times finer and average down (anti-aliased)")
+        ->capture_default_str();
     sub->add_option("--contact-sheet", o->contactSheet,
                     "also write a PNG of 8 frames with the GT silhouettes outlined");
     sub->callback([&g, o]() { runSynth(g, *o); });
