@@ -29,9 +29,11 @@ struct SynthOptions
     double outliers = 0.0;
     std::string size = "640x480";
     int tracks = 600;
-    int keyFrames = 6;
+    int keyFrames = -1;  // default: min(6, frames)
     double distanceRatio = 10.0;
     int supersample = 1;
+    double orbit = 50.0;
+    double elevation = 25.0;
     std::string contactSheet;
 };
 
@@ -153,9 +155,11 @@ void runSynth(const Globals& g, const SynthOptions& o)
     p.outlierFraction = o.outliers;
     p.imageSize = parseSize(o.size);
     p.numTracks = o.tracks;
-    p.numKeyFrames = o.keyFrames;
+    p.numKeyFrames = o.keyFrames > 0 ? o.keyFrames : std::min(6, std::max(2, o.frames));
     p.distanceRatio = o.distanceRatio;
     p.frameSupersample = o.supersample;
+    p.orbitDegrees = o.orbit;
+    p.elevationDegrees = o.elevation;
     Ptr<SceneSynthesizer> synth;
     try
     {
@@ -168,7 +172,8 @@ void runSynth(const Globals& g, const SynthOptions& o)
             {"frames", "--frames"}, {"imageSize", "--size"}, {"noiseSigma", "--noise"},
             {"partialFraction", "--partial"}, {"outlierFraction", "--outliers"},
             {"numTracks", "--tracks"}, {"numKeyFrames", "--key-frames"},
-            {"distanceRatio", "--distance-ratio"}, {"frameSupersample", "--supersample"}};
+            {"distanceRatio", "--distance-ratio"}, {"frameSupersample", "--supersample"},
+            {"orbitDegrees", "--orbit"}, {"elevationDegrees", "--elevation"}};
         std::string flag;
         for (const auto& kv : kFlags)
             if (e.err.find(std::string(kv.first) + " must") != std::string::npos)
@@ -231,6 +236,8 @@ void runSynth(const Globals& g, const SynthOptions& o)
         fs << "outlier_fraction" << p.outlierFraction;
         fs << "distance_ratio" << p.distanceRatio;
         fs << "frame_supersample" << p.frameSupersample;
+        fs << "orbit_degrees" << p.orbitDegrees;
+        fs << "elevation_degrees" << p.elevationDegrees;
         fs << "objects" << "[";
         for (const String& name : scene.objectNames)
             fs << name;
@@ -272,10 +279,14 @@ void registerSynth(CLI::App& app, Globals& g)
         ->capture_default_str();
     sub->add_option("--size", o->size, "frame size WIDTHxHEIGHT")->capture_default_str();
     sub->add_option("--tracks", o->tracks, "number of tracks")->capture_default_str();
-    sub->add_option("--key-frames", o->keyFrames, "key frames (first and last included)")
-        ->capture_default_str();
+    sub->add_option("--key-frames", o->keyFrames,
+                    "key frames, evenly spaced, first and last included (default min(6, frames))");
     sub->add_option("--distance-ratio", o->distanceRatio,
                     "perspective: camera distance / scene size")->capture_default_str();
+    sub->add_option("--orbit", o->orbit, "azimuth swept by the camera, degrees")
+        ->capture_default_str();
+    sub->add_option("--elevation", o->elevation, "mean camera elevation, degrees")
+        ->capture_default_str();
     sub->add_option("--supersample", o->supersample,
                     "render frames K x K times finer and average down (anti-aliased)")
         ->capture_default_str();
