@@ -22,5 +22,6 @@ the real objects, and compositing by depth test.
 #include "opencv2/augocc/clone_builder.hpp"
 #include "opencv2/augocc/compositor.hpp"
 #include "opencv2/augocc/silhouette_editor.hpp"
+#include "opencv2/augocc/key_frames.hpp"
 
 #endif
