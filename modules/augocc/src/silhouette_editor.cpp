@@ -351,6 +351,12 @@ public:
     bool canUndo() const CV_OVERRIDE { return !undo_.empty(); }
     bool canRedo() const CV_OVERRIDE { return !redo_.empty(); }
 
+    void clearHistory() CV_OVERRIDE
+    {
+        undo_.clear();
+        redo_.clear();
+    }
+
     void clear() CV_OVERRIDE
     {
         if (state_.empty())

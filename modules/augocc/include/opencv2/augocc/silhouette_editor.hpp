@@ -140,6 +140,8 @@ public:
     virtual bool redo() = 0;
     virtual bool canUndo() const = 0;
     virtual bool canRedo() const = 0;
+    //! Forgets the undo and redo history (e.g. after loading a saved mask).
+    virtual void clearHistory() = 0;
     //! Removes every contour (undoable).
     virtual void clear() = 0;
 
