@@ -39,8 +39,7 @@ Camera supersampledCamera(const Camera& camera, int factor)
 }
 
 Compositor::Params::Params()
-    : supersample(3), lightDirection(detail::kLightDirection), ambient(detail::kAmbientLight),
-      diffuse(detail::kDiffuseLight)
+    : supersample(3)
 {
 }
 
@@ -104,15 +103,7 @@ public:
         if (p.supersample < 1 || p.supersample > 8)
             CV_Error(Error::StsBadArg, cv::format("Compositor: supersample must be in [1, 8], "
                      "got %d", p.supersample));
-        if (!(cv::norm(p.lightDirection) > 0))
-            CV_Error(Error::StsBadArg, "Compositor: light direction must not be zero");
-        if (!(p.ambient >= 0 && p.diffuse >= 0))
-            CV_Error(Error::StsBadArg, "Compositor: light intensities must be >= 0");
-        const bool relight = p.lightDirection != params_.lightDirection ||
-                             p.ambient != params_.ambient || p.diffuse != params_.diffuse;
         params_ = p;
-        if (relight)
-            dirty_ = true;
     }
 
     void setVirtualObjects(const std::vector<Mesh>& meshes) CV_OVERRIDE
@@ -283,7 +274,6 @@ private:
         if (!dirty_)
             return;
         releaseGpu();
-        const Vec3f L = detail::normalizedLight(params_.lightDirection);
         for (const Mesh& m : meshes_)
         {
             const size_t nv = m.vertices.size();
@@ -293,10 +283,8 @@ private:
             cv::parallel_for_(Range(0, (int)nv), [&](const Range& r) {
                 for (int i = r.start; i < r.end; i++)
                 {
-                    const Vec3f base = hasColors ? m.colors[i] : m.material.diffuse;
-                    const Vec3f amb = hasColors ? m.colors[i] : m.material.ambient;
-                    const Vec3f c = detail::shadeVertex(base, amb, m.normals[i], L,
-                                                        params_.ambient, params_.diffuse);
+                    const Vec3f c = detail::shadeColor(m.material, m.normals[i],
+                                                       hasColors ? m.colors[i] : Vec3f(1, 1, 1));
                     GpuVertex& g = verts[i];
                     g.x = m.vertices[i][0];
                     g.y = m.vertices[i][1];
@@ -348,9 +336,20 @@ private:
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, 0x8191 /* GL_GENERATE_MIPMAP */, GL_TRUE);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, flipped.cols, flipped.rows, 0, GL_RGB,
-                     GL_UNSIGNED_BYTE, flipped.data);
+        // Every mipmap level made on the CPU by INTER_AREA halving, as the synthesizer does, so
+        // that both sample a texture identically.
+        Mat cur = flipped;
+        for (int level = 0;; level++)
+        {
+            glTexImage2D(GL_TEXTURE_2D, level, GL_RGB8, cur.cols, cur.rows, 0, GL_RGB,
+                         GL_UNSIGNED_BYTE, cur.data);
+            if (cur.cols == 1 && cur.rows == 1)
+                break;
+            Mat next;
+            cv::resize(cur, next, Size(std::max(1, cur.cols / 2), std::max(1, cur.rows / 2)), 0,
+                       0, INTER_AREA);
+            cur = next;
+        }
         glBindTexture(GL_TEXTURE_2D, 0);
         return tex;
     }

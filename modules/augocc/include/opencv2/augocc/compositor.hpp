@@ -54,21 +54,20 @@ public:
         the paper's hard depth test; 3 makes occlusion edges soft (see doc/compositor.md for the
         measured error). */
         int supersample;
-        Vec3f lightDirection;  //!< direction TO the light, world frame (default: shading convention)
-        float ambient;         //!< ambient light intensity (default: shading convention)
-        float diffuse;         //!< directional light intensity (default: shading convention)
     };
 
     static Ptr<Compositor> create(const Params& params);
     //! Creates a compositor with default Params.
     static Ptr<Compositor> create();
     virtual Params getParams() const = 0;
-    //! Throws StsBadArg on supersample < 1 or > 8, or a zero light direction.
+    //! Throws StsBadArg on supersample < 1 or > 8.
     virtual void setParams(const Params& params) = 0;
 
     /** @brief Sets the virtual objects, in the world frame of the reconstruction. The meshes are
-    copied, lit once (the light is fixed in the world) and uploaded to the GPU on the next frame.
-    Meshes without normals get smooth normals. An empty list composites nothing. */
+    copied, lit once (the light is fixed in the world: the shading convention of src/shading.hpp,
+    base * (ambient + diffuse * max(0, n.L)), times the texture) and uploaded to the GPU on the
+    next frame. Meshes without normals get smooth normals. An empty list composites nothing.
+    Throws StsBadArg on a face index out of range. */
     virtual void setVirtualObjects(const std::vector<Mesh>& meshes) = 0;
 
     //! Size at which composite() wants the occluder depth: frameSize * supersample.
