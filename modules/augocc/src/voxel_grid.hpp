@@ -110,7 +110,7 @@ struct CarveView
     int pad = 0;
 };
 
-class VoxelGrid
+class CV_EXPORTS VoxelGrid
 {
 public:
     Vec3i dims = Vec3i(0, 0, 0);
@@ -174,7 +174,7 @@ public:
 centre depth; zmax (optional) the farthest. With `frontOnly`, voxels with no exposed face turned
 to the camera are skipped (they cannot change the footprint union). `faces` may be null (every
 voxel drawn). */
-void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, size_t n,
+CV_EXPORTS void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, size_t n,
                  bool frontOnly, Mat& zmin, Mat* zmax);
 
 } // namespace detail
