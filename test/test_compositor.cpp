@@ -315,3 +315,34 @@ TEST(Augocc_Compositor, multithread_reproducibility)
 
 } // namespace
 } // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+
+// Culling the back faces of closed, outward meshes changes no pixel (and a wrong front-face
+// convention would show the inside of the sphere instead).
+TEST(Augocc_Compositor, accuracy_back_face_culling)
+{
+    for (CameraModel model : {SCALED_ORTHOGRAPHIC, PERSPECTIVE})
+    {
+        const Camera cam = makeCamera(model);
+        Mesh sphere = Mesh::sphere(2.f, 24, 12);
+        sphere.transform(Matx44d(1, 0, 0, 0.5, 0, 1, 0, -0.3, 0, 0, 1, kQuadZ, 0, 0, 0, 1));
+        sphere.material.diffuse = Vec3f(0.6f, 0.5f, 0.4f);
+        Mesh box = Mesh::box(Vec3f(-3.5f, -1.f, 9.f), Vec3f(-2.f, 1.5f, 11.f));
+        Mat withCull, without;
+        for (bool cull : {true, false})
+        {
+            Compositor::Params p;
+            p.supersample = 2;
+            p.cullBackFaces = cull;
+            Ptr<Compositor> comp = Compositor::create(p);
+            comp->setVirtualObjects({sphere, box});
+            comp->composite(makeFrame(), cam, noArray(), cull ? withCull : without);
+        }
+        EXPECT_EQ(maxDiff(withCull, without), 0) << cameraModelName(model);
+    }
+}
+
+} // namespace
+} // namespace opencv_test
