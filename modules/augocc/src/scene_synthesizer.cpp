@@ -680,28 +680,8 @@ void renderPasses(GlScene& gl, const SceneModel& m, const Camera& cam, Size size
     }
 }
 
-// The camera of the same view on a grid `k` times finer: fine pixel centre (x + 0.5) lies at
-// k * (coarse x + 0.5), so fine pixels average exactly into coarse ones (INTER_AREA).
-Camera supersampledCamera(Camera cam, int k)
-{
-    if (cam.model == SCALED_ORTHOGRAPHIC)
-    {
-        cam.s *= k;
-        cam.pp = Point2d(k * (cam.pp.x + 0.5) - 0.5, k * (cam.pp.y + 0.5) - 0.5);
-    }
-    else
-    {
-        cam.K(0, 0) *= k;
-        cam.K(0, 1) *= k;
-        cam.K(1, 1) *= k;
-        cam.K(0, 2) = k * (cam.K(0, 2) + 0.5) - 0.5;
-        cam.K(1, 2) = k * (cam.K(1, 2) + 0.5) - 0.5;
-    }
-    return cam;
-}
-
-// renderPasses() with the colour rendered `supersample` times finer and averaged down; labels,
-// depth and silhouettes stay sampled at pixel centres.
+// renderPasses() with the colour rendered `supersample` times finer (supersampledCamera(), from
+// compositor.hpp) and averaged down; labels, depth and silhouettes stay sampled at pixel centres.
 void renderSupersampled(GlScene& gl, const SceneModel& m, const Camera& cam, Size size,
                         int supersample, const std::vector<const detail::GlMesh*>& extra,
                         const std::vector<Vec3f>& extraCorners, const PassOutputs& out)
