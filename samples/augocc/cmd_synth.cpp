@@ -137,6 +137,9 @@ Mat contactSheet(const SyntheticScene& scene)
     return makeContactSheet(images, captions, kSheetColumns, kSheetThumbWidth);
 }
 
+void writeDataSet(const SynthOptions& o, const SceneSynthesizer::Params& p,
+                  const SyntheticScene& scene, Progress& progress);
+
 void runSynth(const Globals& g, const SynthOptions& o)
 {
     SceneSynthesizer::Params p;
@@ -181,17 +184,48 @@ void runSynth(const Globals& g, const SynthOptions& o)
         throw UsageError("synth: " + flag + e.err);
     }
 
+    const fs::path outDir(o.out);
+    std::error_code ec;
+    if (outDir.has_parent_path())
+        fs::create_directories(outDir.parent_path(), ec);
+    if (ec)
+        throw UsageError("--out " + o.out + ": cannot create its parent folder: " + ec.message());
     info(g, "synthesizing " + std::to_string(p.frames) + " frames (" + o.model + ", seed " +
                 std::to_string(o.seed) + ")");
     SyntheticScene scene;
     synth->synthesize(scene);
 
-    const fs::path outDir(o.out);
-    if (outDir.has_parent_path())
-        fs::create_directories(outDir.parent_path());
     Progress progress(g, "writing", (int)scene.frames.size());
     // The whole folder is built under a temporary name and renamed into place: a failure leaves
     // no partial DIR (an existing DIR is replaced only on success).
+    try
+    {
+        writeDataSet(o, p, scene, progress);
+    }
+    catch (const fs::filesystem_error& e)
+    {
+        // Disk full, permissions...: the output cannot be written (nothing partial is left).
+        CV_Error(Error::StsError, "--out " + o.out + ": " + e.what());
+    }
+    progress.finish();
+    if (!o.contactSheet.empty())
+    {
+        const Mat sheet = contactSheet(scene);
+        const fs::path sheetPath(o.contactSheet);
+        if (sheetPath.has_parent_path())
+            fs::create_directories(sheetPath.parent_path(), ec);
+        if (ec)
+            throw UsageError("--contact-sheet " + o.contactSheet + ": cannot create its folder: " +
+                             ec.message());
+        writeAtomically(o.contactSheet, [&](const String& tmp) { writeImage(tmp, sheet); });
+        info(g, "contact sheet: " + o.contactSheet);
+    }
+    info(g, "wrote " + o.out);
+}
+
+void writeDataSet(const SynthOptions& o, const SceneSynthesizer::Params& p,
+                  const SyntheticScene& scene, Progress& progress)
+{
     writeAtomically(o.out, [&](const String& tmpPath) {
         const fs::path tmp(tmpPath);
         fs::create_directories(tmp / "frames");
@@ -246,17 +280,6 @@ void runSynth(const Globals& g, const SynthOptions& o)
         fs << "outlier_tracks" << Mat(scene.outlierTrack).reshape(1, 1);
         fs.release();
     });
-    progress.finish();
-    if (!o.contactSheet.empty())
-    {
-        const Mat sheet = contactSheet(scene);
-        const fs::path sheetPath(o.contactSheet);
-        if (sheetPath.has_parent_path())
-            fs::create_directories(sheetPath.parent_path());
-        writeAtomically(o.contactSheet, [&](const String& tmp) { writeImage(tmp, sheet); });
-        info(g, "contact sheet: " + o.contactSheet);
-    }
-    info(g, "wrote " + o.out);
 }
 
 } // namespace
