@@ -76,8 +76,11 @@ constant s for the whole sequence so that the scene fills about 60% of the frame
 cameras also sit at distance D, so that depths are positive); PERSPECTIVE uses f = s * D, i.e.
 the same framing at the scene centre. Principal point at the image centre ((W-1)/2, (H-1)/2).
 
-Lighting: see src/shading.hpp (ambient + one directional light fixed in the world, per-vertex
-Lambertian shading, diffuse texture modulated); renderWithVirtual() draws virtual meshes with it.
+Lighting (frames and virtual objects alike; src/shading.hpp holds the constants and a GL mesh
+drawer for the compositor): one directional light fixed in the world, towards
+normalize(0.35, 0.8, 0.5) (above, +z and +x side), white; per-vertex colour
+base * (Material::ambient + Material::diffuse * max(0, n . L)) clamped to [0, 1], base = the vertex
+colour or white, multiplied by Material::texture (u right, v up).
 
 Rendering happens on the calling thread with one offscreen OpenGL context owned by the object and
 reused by every call; calls on one object are serialized by a mutex. Each call makes that context
