@@ -434,6 +434,10 @@ TEST(Augocc_SceneSynthesizer, bad_arg)
     EXPECT_THROW(s->renderFrame(12, img), cv::Exception);
     EXPECT_THROW(s->renderWithVirtual(0, {}, img, 0), cv::Exception);
     EXPECT_THROW(s->getCamera(100), cv::Exception);
+    const std::string dir = tempDir("write") + "/scene";
+    EXPECT_THROW(writeSyntheticScene(dir, SyntheticScene(), smallParams(PERSPECTIVE)),
+                 cv::Exception);
+    EXPECT_FALSE(std::filesystem::exists(dir));
 }
 
 TEST(Augocc_SceneSynthesizer, regression_deterministic)

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 #include "opencv2/augocc.hpp"
 
 namespace fs = std::filesystem;
@@ -37,7 +36,6 @@ struct SynthOptions
     std::string contactSheet;
 };
 
-const double kVideoFps = 25.0;
 // Contact sheet: frames shown, columns, thumbnail width, outline colours per object (BGR).
 const int kSheetFrames = 8;
 const int kSheetColumns = 4;
@@ -53,66 +51,6 @@ Size parseSize(const std::string& s)
         h <= 0)
         throw UsageError("--size " + s + ": expected WIDTHxHEIGHT, e.g. 640x480");
     return Size(w, h);
-}
-
-void writeImage(const std::string& path, const Mat& img)
-{
-    if (!imwrite(path, img))
-        CV_Error(Error::StsError, path + ": cannot write");
-}
-
-void writeVideo(const std::string& path, const std::vector<Mat>& frames)
-{
-    // H.264 first (plays everywhere), MPEG-4 part 2 when this FFmpeg has no H.264 encoder.
-    VideoWriter writer;
-    for (const char* cc : {"avc1", "H264", "mp4v"})
-    {
-        writer.open(path, VideoWriter::fourcc(cc[0], cc[1], cc[2], cc[3]), kVideoFps,
-                    frames[0].size());
-        if (writer.isOpened())
-            break;
-    }
-    if (!writer.isOpened())
-        CV_Error(Error::StsError, path + ": no video encoder (H.264 or MPEG-4) could be opened");
-    for (const Mat& f : frames)
-        writer.write(f);
-    writer.release();
-}
-
-// Depth as 16-bit PNG: value = round(z * scale), 0 where nothing; scale a power of ten chosen so
-// that the farthest depth fits, written to depth.yml beside the images.
-void writeDepth(const fs::path& dir, const std::vector<Mat>& depth)
-{
-    fs::create_directories(dir);
-    double maxZ = 0;
-    for (const Mat& d : depth)
-        for (int y = 0; y < d.rows; y++)
-        {
-            const float* row = d.ptr<float>(y);
-            for (int x = 0; x < d.cols; x++)
-                if (std::isfinite(row[x]))
-                    maxZ = std::max(maxZ, (double)row[x]);
-        }
-    double scale = 1;
-    while (maxZ * scale * 10 < 65000 && scale < 1e6)
-        scale *= 10;
-    while (maxZ * scale >= 65000 && scale > 1e-6)
-        scale /= 10;
-    {
-        FileStorage fs((dir / "depth.yml").string(), FileStorage::WRITE);
-        fs << "scale" << scale;
-        fs << "description" << "camera-space z = value / scale; 0 = nothing (infinite)";
-    }
-    parallel_for_(Range(0, (int)depth.size()), [&](const Range& r) {
-        for (int f = r.start; f < r.end; f++)
-        {
-            Mat z = depth[f].clone();
-            z.setTo(0, z == std::numeric_limits<float>::infinity());
-            Mat png;
-            z.convertTo(png, CV_16U, scale);
-            writeImage((dir / format("%04d.png", f)).string(), png);
-        }
-    });
 }
 
 Mat contactSheet(const SyntheticScene& scene)
@@ -136,9 +74,6 @@ Mat contactSheet(const SyntheticScene& scene)
     }
     return makeContactSheet(images, captions, kSheetColumns, kSheetThumbWidth);
 }
-
-void writeDataSet(const SynthOptions& o, const SceneSynthesizer::Params& p,
-                  const SyntheticScene& scene, Progress& progress);
 
 void runSynth(const Globals& g, const SynthOptions& o)
 {
@@ -198,15 +133,7 @@ void runSynth(const Globals& g, const SynthOptions& o)
     Progress progress(g, "writing", (int)scene.frames.size());
     // The whole folder is built under a temporary name and renamed into place: a failure leaves
     // no partial DIR (an existing DIR is replaced only on success).
-    try
-    {
-        writeDataSet(o, p, scene, progress);
-    }
-    catch (const fs::filesystem_error& e)
-    {
-        // Disk full, permissions...: the output cannot be written (nothing partial is left).
-        CV_Error(Error::StsError, "--out " + o.out + ": " + e.what());
-    }
+    writeSyntheticScene(o.out, scene, p, [&progress](int done, int) { progress.update(done); });
     progress.finish();
     if (!o.contactSheet.empty())
     {
@@ -217,69 +144,13 @@ void runSynth(const Globals& g, const SynthOptions& o)
         if (ec)
             throw UsageError("--contact-sheet " + o.contactSheet + ": cannot create its folder: " +
                              ec.message());
-        writeAtomically(o.contactSheet, [&](const String& tmp) { writeImage(tmp, sheet); });
+        writeAtomically(o.contactSheet, [&](const String& tmp) {
+            if (!imwrite(tmp, sheet))
+                CV_Error(Error::StsError, o.contactSheet + ": cannot write");
+        });
         info(g, "contact sheet: " + o.contactSheet);
     }
     info(g, "wrote " + o.out);
-}
-
-void writeDataSet(const SynthOptions& o, const SceneSynthesizer::Params& p,
-                  const SyntheticScene& scene, Progress& progress)
-{
-    writeAtomically(o.out, [&](const String& tmpPath) {
-        const fs::path tmp(tmpPath);
-        fs::create_directories(tmp / "frames");
-        fs::create_directories(tmp / "gt" / "labels");
-        // PNG encoding dominates: frames and labels in parallel (each chunk its own files).
-        const int F = (int)scene.frames.size();
-        const int chunk = 8;
-        for (int start = 0; start < F; start += chunk)
-        {
-            const int end = std::min(F, start + chunk);
-            parallel_for_(Range(start, end), [&](const Range& r) {
-                for (int f = r.start; f < r.end; f++)
-                {
-                    writeImage((tmp / "frames" / format("%04d.png", f)).string(),
-                               scene.frames[f]);
-                    writeImage((tmp / "gt" / "labels" / format("%04d.png", f)).string(),
-                               scene.labels[f]);
-                }
-            });
-            progress.update(end);
-        }
-        writeVideo((tmp / "video.mp4").string(), scene.frames);
-        fs::create_directories(tmp / "input");
-        fs::create_directories(tmp / "gt");
-        writeMasks((tmp / "input" / "masks").string(), scene.keyFrameMasks);
-        writeMasks((tmp / "gt" / "masks").string(), scene.wholeMasks);
-        writeMasks((tmp / "gt" / "visible_masks").string(), scene.visibleMasks);
-        writeReconstruction((tmp / "gt" / "reconstruction.yml").string(), scene.groundTruth);
-        writeTracks((tmp / "tracks.yml").string(), scene.tracks);
-        writeTracks((tmp / "gt" / "clean_tracks.yml").string(), scene.cleanTracks);
-        writeDepth(tmp / "gt" / "depth", scene.depth);
-        fs::create_directories(tmp / "gt" / "meshes");
-        for (size_t i = 0; i < scene.objectNames.size(); i++)
-            writeMeshPly((tmp / "gt" / "meshes" / (scene.objectNames[i] + ".ply")).string(),
-                         scene.objectMeshes[i]);
-        FileStorage fs((tmp / "gt" / "synth.yml").string(), FileStorage::WRITE);
-        fs << "model" << cameraModelName(p.model);
-        fs << "frames" << p.frames;
-        fs << "seed" << format("%llu", o.seed);
-        fs << "noise_sigma" << p.noiseSigma;
-        fs << "partial_fraction" << p.partialFraction;
-        fs << "outlier_fraction" << p.outlierFraction;
-        fs << "distance_ratio" << p.distanceRatio;
-        fs << "frame_supersample" << p.frameSupersample;
-        fs << "orbit_degrees" << p.orbitDegrees;
-        fs << "elevation_degrees" << p.elevationDegrees;
-        fs << "objects" << "[";
-        for (const String& name : scene.objectNames)
-            fs << name;
-        fs << "]";
-        fs << "key_frames" << Mat(scene.keyFrames).reshape(1, 1);
-        fs << "outlier_tracks" << Mat(scene.outlierTrack).reshape(1, 1);
-        fs.release();
-    });
 }
 
 } // namespace

@@ -4,6 +4,7 @@
 #ifndef OPENCV_AUGOCC_SCENE_SYNTHESIZER_HPP
 #define OPENCV_AUGOCC_SCENE_SYNTHESIZER_HPP
 
+#include <functional>
 #include <vector>
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/camera.hpp"
@@ -157,6 +158,24 @@ public:
     //! True geometry of the real objects (world coordinates, textured), in label order.
     virtual std::vector<Mesh> getObjectMeshes() const = 0;
 };
+
+/** @brief Writes a synthesized data set to a folder, as `augocc synth` does: frames/%04d.png,
+video.mp4 (H.264, else MPEG-4 part 2), tracks.yml, input/masks (key frames), gt/masks (whole),
+gt/visible_masks, gt/reconstruction.yml, gt/clean_tracks.yml, gt/depth (16-bit PNG, z = value /
+scale, scale in gt/depth/depth.yml, 0 = nothing), gt/labels, gt/meshes/<object>.ply and
+gt/synth.yml (parameters, objects, key frames, outlier flags). See doc/synthesizer.md.
+
+The folder is built under a temporary name beside `dir` and renamed into place: a failure leaves
+no partial folder; an existing `dir` is replaced on success only.
+@param dir output folder.
+@param scene the data set (from SceneSynthesizer::synthesize).
+@param params the parameters it was made with (recorded in gt/synth.yml).
+@param progress optional callback (frames written, total), called from the calling thread.
+*/
+CV_EXPORTS void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
+                                    const SceneSynthesizer::Params& params,
+                                    const std::function<void(int done, int total)>& progress =
+                                        nullptr);
 
 //! @}
 

@@ -1,0 +1,165 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// writeSyntheticScene(): a synthesized data set on disk (the layout of `augocc synth`,
+// doc/synthesizer.md).
+
+#include "precomp.hpp"
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace cv {
+namespace augocc {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const double kVideoFps = 25.0;
+// Frames encoded per parallel batch (progress is reported between batches).
+const int kWriteBatch = 8;
+
+void writeImage(const String& path, const Mat& img)
+{
+    if (!imwrite(path, img))
+        CV_Error(Error::StsError, path + ": cannot write");
+}
+
+void writeVideo(const String& path, const std::vector<Mat>& frames)
+{
+    // H.264 first (plays everywhere), MPEG-4 part 2 when this FFmpeg has no H.264 encoder.
+    VideoWriter writer;
+    for (const char* cc : {"avc1", "H264", "mp4v"})
+    {
+        writer.open(path, VideoWriter::fourcc(cc[0], cc[1], cc[2], cc[3]), kVideoFps,
+                    frames[0].size());
+        if (writer.isOpened())
+            break;
+    }
+    if (!writer.isOpened())
+        CV_Error(Error::StsError, path + ": no video encoder (H.264 or MPEG-4) could be opened");
+    for (const Mat& f : frames)
+        writer.write(f);
+    writer.release();
+}
+
+// Depth as 16-bit PNG: value = round(z * scale), 0 where nothing; scale a power of ten chosen so
+// that the farthest depth fits, written to depth.yml beside the images.
+void writeDepth(const fs::path& dir, const std::vector<Mat>& depth)
+{
+    fs::create_directories(dir);
+    double maxZ = 0;
+    for (const Mat& d : depth)
+        for (int y = 0; y < d.rows; y++)
+        {
+            const float* row = d.ptr<float>(y);
+            for (int x = 0; x < d.cols; x++)
+                if (std::isfinite(row[x]))
+                    maxZ = std::max(maxZ, (double)row[x]);
+        }
+    double scale = 1;
+    while (maxZ * scale * 10 < 65000 && scale < 1e6)
+        scale *= 10;
+    while (maxZ * scale >= 65000 && scale > 1e-6)
+        scale /= 10;
+    {
+        FileStorage fs((dir / "depth.yml").string(), FileStorage::WRITE);
+        fs << "scale" << scale;
+        fs << "description" << "camera-space z = value / scale; 0 = nothing (infinite)";
+    }
+    parallel_for_(Range(0, (int)depth.size()), [&](const Range& r) {
+        for (int f = r.start; f < r.end; f++)
+        {
+            Mat z = depth[f].clone();
+            z.setTo(0, z == std::numeric_limits<float>::infinity());
+            Mat png;
+            z.convertTo(png, CV_16U, scale);
+            writeImage((dir / format("%04d.png", f)).string(), png);
+        }
+    });
+}
+
+} // namespace
+
+void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
+                         const SceneSynthesizer::Params& p,
+                         const std::function<void(int done, int total)>& progress)
+{
+    const int F = (int)scene.frames.size();
+    if (F == 0)
+        CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: the scene has no frame");
+    if ((int)scene.labels.size() != F || (int)scene.depth.size() != F)
+        CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: frames, labels and depth differ "
+                 "in count");
+    try
+    {
+        const fs::path target(dir);
+        if (target.has_parent_path())
+            fs::create_directories(target.parent_path());
+        writeAtomically(dir, [&](const String& tmpPath) {
+            const fs::path tmp(tmpPath);
+            fs::create_directories(tmp / "frames");
+            fs::create_directories(tmp / "gt" / "labels");
+            // PNG encoding dominates: frames and labels in parallel (each chunk its own files).
+            for (int start = 0; start < F; start += kWriteBatch)
+            {
+                const int end = std::min(F, start + kWriteBatch);
+                parallel_for_(Range(start, end), [&](const Range& r) {
+                    for (int f = r.start; f < r.end; f++)
+                    {
+                        writeImage((tmp / "frames" / format("%04d.png", f)).string(),
+                                   scene.frames[f]);
+                        writeImage((tmp / "gt" / "labels" / format("%04d.png", f)).string(),
+                                   scene.labels[f]);
+                    }
+                });
+                if (progress)
+                    progress(end, F);
+            }
+            writeVideo((tmp / "video.mp4").string(), scene.frames);
+            fs::create_directories(tmp / "input");
+            fs::create_directories(tmp / "gt");
+            writeMasks((tmp / "input" / "masks").string(), scene.keyFrameMasks);
+            writeMasks((tmp / "gt" / "masks").string(), scene.wholeMasks);
+            writeMasks((tmp / "gt" / "visible_masks").string(), scene.visibleMasks);
+            writeReconstruction((tmp / "gt" / "reconstruction.yml").string(), scene.groundTruth);
+            writeTracks((tmp / "tracks.yml").string(), scene.tracks);
+            writeTracks((tmp / "gt" / "clean_tracks.yml").string(), scene.cleanTracks);
+            writeDepth(tmp / "gt" / "depth", scene.depth);
+            fs::create_directories(tmp / "gt" / "meshes");
+            for (size_t i = 0; i < scene.objectNames.size(); i++)
+                writeMeshPly((tmp / "gt" / "meshes" / (scene.objectNames[i] + ".ply")).string(),
+                             scene.objectMeshes[i]);
+            FileStorage info((tmp / "gt" / "synth.yml").string(), FileStorage::WRITE);
+            if (!info.isOpened())
+                CV_Error(Error::StsError, dir + ": cannot write gt/synth.yml");
+            info << "model" << cameraModelName(p.model);
+            info << "frames" << p.frames;
+            info << "seed" << format("%llu", (unsigned long long)p.seed);
+            info << "noise_sigma" << p.noiseSigma;
+            info << "partial_fraction" << p.partialFraction;
+            info << "outlier_fraction" << p.outlierFraction;
+            info << "distance_ratio" << p.distanceRatio;
+            info << "frame_supersample" << p.frameSupersample;
+            info << "orbit_degrees" << p.orbitDegrees;
+            info << "elevation_degrees" << p.elevationDegrees;
+            info << "objects" << "[";
+            for (const String& name : scene.objectNames)
+                info << name;
+            info << "]";
+            info << "key_frames" << Mat(scene.keyFrames).reshape(1, 1);
+            info << "outlier_tracks" << Mat(scene.outlierTrack).reshape(1, 1);
+            info.release();
+        });
+    }
+    catch (const fs::filesystem_error& e)
+    {
+        // Disk full, permissions...: nothing partial is left (writeAtomically cleans up).
+        CV_Error(Error::StsError, dir + ": " + e.what());
+    }
+}
+
+} // namespace augocc
+} // namespace cv
