@@ -38,6 +38,7 @@ BENCHMARK(Augocc_SceneSynthesizer_renderFrame)
     ->Args({640, 480})
     ->Args({1280, 720})
     ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()  // CPU column: all threads (llvmpipe rasterizes on worker threads)
     ->UseRealTime();
 
 /* The whole data set, per frame: synthesize() of 30 frames at 640x480 (textures, rendering,
