@@ -131,7 +131,8 @@ enum TextureStyle
 };
 
 /* A texture rich in corners at several scales for a KLT tracker: value noise for low-frequency
-variation, random blobs, lines, small high-contrast speckles, and windows on facades. BGR CV_8UC3. */
+variation, random blobs, lines, small high-contrast speckles, and windows on facades.
+BGR CV_8UC3. */
 Mat makeTexture(RNG& rng, Size size, const Vec3f& baseRgb, TextureStyle style)
 {
     const Mat noise = valueNoise(rng, size, size.width / 4.0, 5);
@@ -814,7 +815,8 @@ void makeTracks(const SceneSynthesizer::Params& p, const SceneModel& m, const Ma
         std::swap(perm[i], perm[rng.uniform(0, i + 1)]);
 
     scene.outlierTrack.assign(P, 0);
-    scene.groundTruth.points = Mat(P, 3, CV_64F, Scalar::all(std::numeric_limits<double>::quiet_NaN()));
+    scene.groundTruth.points = Mat(P, 3, CV_64F,
+                                   Scalar::all(std::numeric_limits<double>::quiet_NaN()));
     Mat clean(F, P, CV_32FC2), noisy(F, P, CV_32FC2);
     const float nan = std::numeric_limits<float>::quiet_NaN();
     for (int i = 0; i < P; i++)

@@ -46,19 +46,32 @@ wide field of view).
 */
 struct CV_EXPORTS SyntheticScene
 {
-    std::vector<Mat> frames;          //!< BGR CV_8UC3, one per frame
-    Reconstruction groundTruth;       //!< true camera of every frame, and true 3D point per track
-    Tracks tracks;                    //!< measured tracks: noise, partial and outlier tracks per Params
-    Tracks cleanTracks;               //!< noise-free projections of the same tracks (NaN where unobserved)
-    std::vector<uchar> outlierTrack;  //!< 1 where track p is a gross outlier (not a 3D point)
-    std::vector<String> objectNames;  //!< real objects, front to back is not implied
-    std::vector<Mesh> objectMeshes;   //!< true geometry of each real object, world coordinates
-    ObjectMasks wholeMasks;           //!< per object, every frame: the whole silhouette (as if alone)
-    ObjectMasks visibleMasks;         //!< per object, every frame: the silhouette others leave visible
-    ObjectMasks keyFrameMasks;        //!< the user's input: visible silhouettes in the key frames
-    std::vector<int> keyFrames;       //!< key frames (first and last included)
-    std::vector<Mat> depth;           //!< CV_32F camera-space z per pixel (+inf where nothing)
-    std::vector<Mat> labels;          //!< CV_8U: 0 ground/background, i + 1 where object i is seen
+    //! BGR CV_8UC3, one per frame
+    std::vector<Mat> frames;
+    //! true camera of every frame, and true 3D point per track (NaN row: outlier track)
+    Reconstruction groundTruth;
+    //! measured tracks: noise, partial and outlier tracks per Params
+    Tracks tracks;
+    //! noise-free projections of the same tracks (same NaN pattern; outliers as in `tracks`)
+    Tracks cleanTracks;
+    //! 1 where track p is a gross outlier (not a 3D point)
+    std::vector<uchar> outlierTrack;
+    //! real objects ("building", "lblock", "tower"); front to back is not implied
+    std::vector<String> objectNames;
+    //! true geometry of each real object, world coordinates
+    std::vector<Mesh> objectMeshes;
+    //! per object, every frame: the whole silhouette (as if alone)
+    ObjectMasks wholeMasks;
+    //! per object, every frame: the silhouette others leave visible
+    ObjectMasks visibleMasks;
+    //! the user's input: visible silhouettes in the key frames
+    ObjectMasks keyFrameMasks;
+    //! key frames (first and last included)
+    std::vector<int> keyFrames;
+    //! CV_32F camera-space z per pixel (+inf where nothing)
+    std::vector<Mat> depth;
+    //! CV_8U: 0 ground/background, i + 1 where object i is seen
+    std::vector<Mat> labels;
 };
 
 /** @brief Renders, headless through OSMesa, a textured static scene (a ground plane and several
@@ -95,21 +108,33 @@ public:
         /** Defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg).
         Valid ranges (setParams() throws StsBadArg/StsOutOfRange otherwise): frames >= 2, both image
         sides >= 32, distanceRatio >= 1, orbitDegrees in [0, 360], elevationDegrees in (0, 90),
-        numTracks >= 1, noiseSigma >= 0, fractions in [0, 1] with partial + outlier <= 1,
+        numTracks >= 1, noiseSigma >= 0, both fractions in [0, 1],
         numKeyFrames in [2, frames], frameSupersample in [1, 8]. */
         Params();
-        int frames;                         //!< number of frames (default 60)
-        Size imageSize;                     //!< frame size (default 640x480)
-        CameraModel model;                  //!< camera model of the frames (default SCALED_ORTHOGRAPHIC)
-        double distanceRatio;               //!< PERSPECTIVE: camera distance / scene size (default 10)
-        double orbitDegrees;                //!< azimuth swept by the camera over the sequence (default 50)
-        double elevationDegrees;            //!< mean elevation of the camera above the ground (default 25)
-        int numTracks;                      //!< tracks (3D points on the objects and ground) (default 600)
-        double noiseSigma;                  //!< Gaussian pixel noise of `tracks` (per axis) (default 0.5)
-        double partialFraction;             //!< fraction of tracks that start/end mid-sequence (default 0)
-        double outlierFraction;             //!< fraction of tracks that are gross outliers (default 0)
-        int numKeyFrames;                   //!< key frames, evenly spaced, first and last included (default 6)
-        uint64 seed;                        //!< random seed (textures, points, noise) (default 1)
+        //! number of frames (default 60)
+        int frames;
+        //! frame size (default 640x480)
+        Size imageSize;
+        //! camera model of the frames (default SCALED_ORTHOGRAPHIC)
+        CameraModel model;
+        //! camera distance / scene size (default 10); the framing stays the same
+        double distanceRatio;
+        //! azimuth swept by the camera over the sequence, degrees (default 50)
+        double orbitDegrees;
+        //! mean elevation of the camera above the ground, degrees (default 25)
+        double elevationDegrees;
+        //! tracks (3D points on the objects and ground) (default 600)
+        int numTracks;
+        //! Gaussian pixel noise of `tracks`, per axis (default 0.5)
+        double noiseSigma;
+        //! fraction of tracks that start/end mid-sequence (default 0)
+        double partialFraction;
+        //! fraction of tracks that are gross outliers (default 0)
+        double outlierFraction;
+        //! key frames, evenly spaced, first and last included (default 6)
+        int numKeyFrames;
+        //! random seed (textures, jitter, points, noise) (default 1)
+        uint64 seed;
         /** Frames are rendered at this factor and averaged down (INTER_AREA), i.e. anti-aliased
         like a camera integrating over each pixel; masks, labels and depth are always sampled at
         pixel centres. 1 = one sample per pixel (default 1, valid [1, 8]). */
