@@ -1,14 +1,632 @@
-// augocc annotate: placeholder until its stage lands (exit 2, "not implemented yet").
+// augocc annotate: the interactive key-frame silhouette tool (the paper's Section 5).
+// A thin highgui shell over cv::augocc::SilhouetteEditor: the window forwards clicks and keys,
+// the editor does the tracing, snapping, filling and undo.
 
 #include "cli_common.hpp"
 
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+
+#include <opencv2/highgui.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/augocc.hpp>
+
 namespace augocc_cli {
 
-void registerAnnotate(CLI::App& app, Globals&)
+namespace {
+
+namespace fs = std::filesystem;
+using namespace cv;
+using namespace cv::augocc;
+
+const char* const kWindow = "augocc annotate";
+// A click within this distance of an anchor grabs it (pixels; about a fingertip on a mouse).
+const double kGrabRadius = 6.0;
+const int kStatusHeight = 46;   // two text lines under the frame
+const int kTimelineHeight = 10; // key-frame ruler under the text
+
+const char* const kHelp[][2] = {
+    {"left click", "add anchor; on the first anchor: close; drag: move anchor"},
+    {"right click", "close contour / delete the anchor under the cursor"},
+    {"l", "toggle live wire / straight segments"},
+    {"c, Enter", "close contour"},
+    {"Backspace, b", "remove the last anchor"},
+    {"u, z  /  r, y", "undo  /  redo"},
+    {"i  /  d", "insert anchor on segment  /  delete anchor (at cursor)"},
+    {"x", "clear this frame's silhouette"},
+    {"g", "propose outline from the nearest key frame, snapped"},
+    {"n, .  /  p, ,", "next  /  previous frame"},
+    {"]  /  [", "next  /  previous key frame"},
+    {"k", "mark / unmark this frame as a key frame"},
+    {"o  /  a", "next object  /  add an object"},
+    {"s  /  q, Esc", "save masks  /  save and quit"},
+    {"w  /  h", "save a screenshot  /  this help"},
+};
+
+struct Options
 {
-    CLI::App* sub = app.add_subcommand("annotate", "(not implemented yet)");
-    sub->allow_extras();
-    sub->callback([]() { throw UsageError("annotate: not implemented yet"); });
+    std::string input, masks, tracks, reconstruction, screenshotDir;
+    std::vector<std::string> objects;
+    int frame = 0, suggest = 0;
+};
+
+class AnnotateApp
+{
+public:
+    AnnotateApp(const Options& o, const Globals& g) : opt_(o), g_(g) {}
+
+    void run()
+    {
+        source_ = FrameSource::open(opt_.input);
+        frameCount_ = source_->count();
+        frameSize_ = source_->size();
+        if (frameCount_ <= 0)
+            throw UsageError("--input " + opt_.input + ": no frames");
+        if (fs::exists(opt_.masks))
+            masks_ = readMasks(opt_.masks, frameSize_);
+        for (const auto& om : masks_)
+            addObject(om.first);
+        for (const std::string& name : opt_.objects)
+            addObject(name);
+        if (objects_.empty())
+            addObject("object");
+        if (!opt_.objects.empty())
+            object_ = indexOf(opt_.objects.front());
+        suggestKeyFrameMarks();
+        frame_ = std::min(std::max(opt_.frame, 0), frameCount_ - 1);
+        loadFrame();
+
+        namedWindow(kWindow, WINDOW_AUTOSIZE | WINDOW_GUI_NORMAL);
+        setMouseCallback(kWindow, &AnnotateApp::onMouse, this);
+        render();
+        waitKey(50);
+        // Where the frame lies on the screen: tests and scripts driving the window with
+        // xdotool read this line (the image is shown 1:1 from the rectangle's top-left).
+        const Rect r = getWindowImageRect(kWindow);
+        info(g_, format("annotate: window image rect %d %d %d %d", r.x, r.y, r.width, r.height));
+        bool quit = false;
+        while (!quit)
+        {
+            if (dirty_)
+                render();
+            const int key = waitKeyEx(15);
+            if (key >= 0)
+                quit = handleKey(key);
+            else if (getWindowProperty(kWindow, WND_PROP_VISIBLE) == 0)
+                quit = true;  // the window was closed
+        }
+        save();
+        destroyAllWindows();
+        waitKey(1);
+    }
+
+private:
+    // ---- objects, frames, key frames --------------------------------------------------------
+
+    void addObject(const std::string& name)
+    {
+        if (name.empty() || name.find('/') != std::string::npos || name[0] == '.')
+            throw UsageError("--object '" + name + "': not a valid folder name");
+        if (indexOf(name) < 0)
+        {
+            objects_.push_back(name);
+            std::set<int>& marks = keyMarks_[name];
+            marks.insert(0);
+            marks.insert(frameCount_ - 1);
+            for (const auto& fm : masks_[name])
+                marks.insert(fm.first);
+        }
+    }
+
+    int indexOf(const std::string& name) const
+    {
+        for (size_t i = 0; i < objects_.size(); ++i)
+            if (objects_[i] == name)
+                return int(i);
+        return -1;
+    }
+
+    const std::string& objectName() const { return objects_[object_]; }
+
+    void suggestKeyFrameMarks()
+    {
+        if (opt_.suggest <= 0)
+            return;
+        if (opt_.tracks.empty() && opt_.reconstruction.empty())
+            throw UsageError("--suggest needs --tracks and/or --reconstruction");
+        Tracks tracks;
+        Reconstruction rec;
+        if (!opt_.tracks.empty())
+            tracks = readTracks(opt_.tracks);
+        if (!opt_.reconstruction.empty())
+            rec = readReconstruction(opt_.reconstruction);
+        for (const std::string& name : objects_)
+        {
+            std::vector<int> keys;
+            const FrameMasks& fm = masks_[name];
+            if (!opt_.tracks.empty() && !opt_.reconstruction.empty())
+                keys = suggestKeyFrames(tracks, rec, opt_.suggest, fm);
+            else if (!opt_.tracks.empty())
+                keys = suggestKeyFrames(tracks, opt_.suggest,
+                                        fm.empty() ? std::vector<uchar>()
+                                                   : objectTracksFromMasks(tracks, fm));
+            else
+                keys = suggestKeyFrames(rec, opt_.suggest);
+            std::string list;
+            for (int k : keys)
+            {
+                if (k < frameCount_)
+                    keyMarks_[name].insert(k);
+                list += format(" %d", k);
+            }
+            info(g_, "annotate: suggested key frames for " + name + ":" + list);
+        }
+    }
+
+    void loadFrame()
+    {
+        source_->seek(frame_);
+        if (!source_->read(image_) || image_.empty())
+            throw UsageError(format("--input %s: cannot read frame %d", opt_.input.c_str(),
+                                    frame_));
+        editor_ = editorFor(object_, frame_);
+        dirty_ = true;
+    }
+
+    // One editor per (object, frame) visited, so that going back to a frame keeps its open
+    // contour and its undo history.
+    Ptr<SilhouetteEditor> editorFor(int object, int frame)
+    {
+        auto key = std::make_pair(object, frame);
+        auto it = editors_.find(key);
+        if (it != editors_.end())
+        {
+            it->second->setSegmentMode(mode_);
+            return it->second;
+        }
+        Ptr<SilhouetteEditor> ed = SilhouetteEditor::create();
+        ed->setImage(image_);
+        const FrameMasks& fm = masks_[objects_[object]];
+        auto m = fm.find(frame);
+        if (m != fm.end())
+        {
+            ed->loadMask(m->second);
+            ed->clearHistory();  // loading is not an edit of the user's
+        }
+        ed->setSegmentMode(mode_);
+        editors_[key] = ed;
+        return ed;
+    }
+
+    // The editor's silhouette becomes the frame's mask once the user has changed it.
+    void commitEditor()
+    {
+        if (!editor_)
+            return;
+        if (!editor_->canUndo() && !editor_->canRedo())
+            return;  // untouched: the loaded mask (if any) stands
+        Mat mask;
+        editor_->getMask(mask);
+        FrameMasks& fm = masks_[objectName()];
+        const bool had = fm.count(frame_) > 0;
+        if (countNonZero(mask) > 0)
+        {
+            if (!had || norm(fm[frame_], mask, NORM_INF) > 0)
+                modified_ = true;
+            fm[frame_] = mask;
+            keyMarks_[objectName()].insert(frame_);
+        }
+        else if (had)
+        {
+            fm.erase(frame_);
+            modified_ = true;
+        }
+    }
+
+    void gotoFrame(int f)
+    {
+        f = std::min(std::max(f, 0), frameCount_ - 1);
+        if (f == frame_)
+            return;
+        commitEditor();
+        frame_ = f;
+        loadFrame();
+    }
+
+    void gotoObject(int o)
+    {
+        commitEditor();
+        object_ = o;
+        editor_ = editorFor(object_, frame_);
+        dirty_ = true;
+    }
+
+    void save()
+    {
+        commitEditor();
+        for (auto& e : editors_)
+        {
+            if (!e.second->canUndo() && !e.second->canRedo())
+                continue;
+            Mat mask;
+            e.second->getMask(mask);
+            FrameMasks& fm = masks_[objects_[e.first.first]];
+            if (countNonZero(mask) > 0)
+                fm[e.first.second] = mask;
+            else
+                fm.erase(e.first.second);
+        }
+        ObjectMasks out;
+        for (const std::string& name : objects_)
+            out[name] = masks_[name];
+        writeMasks(opt_.masks, out);
+        modified_ = false;
+        int total = 0;
+        for (const auto& om : out)
+            total += int(om.second.size());
+        status_ = format("saved %d mask(s) to %s", total, opt_.masks.c_str());
+        info(g_, "annotate: " + status_);
+        dirty_ = true;
+    }
+
+    // ---- input --------------------------------------------------------------------------------
+
+    static void onMouse(int event, int x, int y, int flags, void* self)
+    {
+        static_cast<AnnotateApp*>(self)->mouse(event, Point(x, y), flags);
+    }
+
+    void mouse(int event, Point p, int)
+    {
+        const bool onFrame = Rect(Point(), frameSize_).contains(p);
+        if (event == EVENT_MOUSEMOVE)
+        {
+            cursor_ = onFrame ? p : Point(-1, -1);
+            dirty_ = true;
+            return;
+        }
+        if (!onFrame)
+            return;
+        if (event == EVENT_LBUTTONDOWN)
+        {
+            int c, a;
+            if (editor_->hasOpenContour())
+            {
+                const int open = editor_->getContourCount() - 1;
+                const std::vector<Point> anchors = editor_->getAnchors(open);
+                if (anchors.size() >= 3 && norm(anchors.front() - p) <= kGrabRadius)
+                    editor_->closeContour();
+                else
+                    editor_->addPoint(p);
+            }
+            else if (editor_->findAnchor(p, kGrabRadius, c, a))
+            {
+                dragContour_ = c;
+                dragAnchor_ = a;
+            }
+            else
+                editor_->addPoint(p);
+            dirty_ = true;
+        }
+        else if (event == EVENT_LBUTTONUP && dragContour_ >= 0)
+        {
+            const Point from = editor_->getAnchors(dragContour_)[dragAnchor_];
+            if (from != p)
+                editor_->moveAnchor(dragContour_, dragAnchor_, p);
+            dragContour_ = dragAnchor_ = -1;
+            dirty_ = true;
+        }
+        else if (event == EVENT_RBUTTONDOWN)
+        {
+            int c, a;
+            if (editor_->hasOpenContour())
+                editor_->closeContour();
+            else if (editor_->findAnchor(p, kGrabRadius, c, a))
+                editor_->removeAnchor(c, a);
+            dirty_ = true;
+        }
+    }
+
+    // Returns true to quit. Qt's highgui reports letters upper-case and other keys as X keysyms.
+    bool handleKey(int key)
+    {
+        dirty_ = true;
+        status_.clear();
+        if (key >= 'A' && key <= 'Z')
+            key = key - 'A' + 'a';
+        switch (key)
+        {
+        case 'q': case 27: case 65307:
+            return true;
+        case 'h':
+            help_ = !help_;
+            break;
+        case 'l':
+            mode_ = mode_ == SilhouetteEditor::LIVE_WIRE ? SilhouetteEditor::STRAIGHT
+                                                        : SilhouetteEditor::LIVE_WIRE;
+            editor_->setSegmentMode(mode_);
+            break;
+        case 'c': case 13: case 10: case 65293: case 65421:
+            if (!editor_->closeContour())
+                status_ = "nothing to close (a contour needs 3 anchors)";
+            break;
+        case 8: case 127: case 65288: case 'b':
+            editor_->removeLastPoint();
+            break;
+        case 'u': case 'z':
+            if (!editor_->undo())
+                status_ = "nothing to undo";
+            break;
+        case 'r': case 'y':
+            if (!editor_->redo())
+                status_ = "nothing to redo";
+            break;
+        case 'i':
+            if (cursor_.x < 0 || !editor_->insertAnchor(cursor_, 3 * kGrabRadius))
+                status_ = "no segment near the cursor";
+            break;
+        case 'd':
+        {
+            int c, a;
+            if (cursor_.x >= 0 && editor_->findAnchor(cursor_, kGrabRadius, c, a))
+                editor_->removeAnchor(c, a);
+            else
+                status_ = "no anchor under the cursor";
+            break;
+        }
+        case 'x':
+            editor_->clear();
+            break;
+        case 'g':
+            propose();
+            break;
+        case 'n': case '.': case 65363:
+            gotoFrame(frame_ + 1);
+            break;
+        case 'p': case ',': case 65361:
+            gotoFrame(frame_ - 1);
+            break;
+        case ']': case 65366:
+            gotoKeyFrame(+1);
+            break;
+        case '[': case 65365:
+            gotoKeyFrame(-1);
+            break;
+        case 'k':
+        {
+            std::set<int>& marks = keyMarks_[objectName()];
+            if (!marks.erase(frame_))
+                marks.insert(frame_);
+            break;
+        }
+        case 'o':
+            gotoObject((object_ + 1) % int(objects_.size()));
+            break;
+        case 'a':
+        {
+            int n = int(objects_.size()) + 1;
+            while (indexOf(format("object%d", n)) >= 0)
+                ++n;
+            addObject(format("object%d", n));
+            gotoObject(int(objects_.size()) - 1);
+            status_ = "added " + objectName();
+            break;
+        }
+        case 's':
+            save();
+            break;
+        case 'w':
+            screenshot();
+            break;
+        default:
+            break;
+        }
+        return false;
+    }
+
+    void gotoKeyFrame(int dir)
+    {
+        const std::set<int>& marks = keyMarks_[objectName()];
+        if (dir > 0)
+        {
+            auto it = marks.upper_bound(frame_);
+            if (it != marks.end())
+                gotoFrame(*it);
+        }
+        else
+        {
+            auto it = marks.lower_bound(frame_);
+            if (it != marks.begin())
+                gotoFrame(*std::prev(it));
+        }
+    }
+
+    // An outline for this frame from the nearest frame that has this object's silhouette,
+    // snapped to this frame's edges (good for neighbouring frames; `augocc propagate` proposes
+    // from the clones for frames far apart).
+    void propose()
+    {
+        commitEditor();
+        const FrameMasks& fm = masks_[objectName()];
+        int best = -1;
+        for (const auto& m : fm)
+            if (m.first != frame_ && (best < 0 || std::abs(m.first - frame_) <
+                                                      std::abs(best - frame_)))
+                best = m.first;
+        if (best < 0)
+        {
+            status_ = "no other frame has a silhouette of " + objectName() + " to propose from";
+            return;
+        }
+        editor_->loadMask(fm.at(best), true);
+        status_ = format("proposed from frame %d, snapped to edges", best);
+    }
+
+    void screenshot()
+    {
+        const std::string dir = opt_.screenshotDir.empty()
+                                    ? fs::absolute(opt_.masks).parent_path().string()
+                                    : opt_.screenshotDir;
+        fs::create_directories(dir);
+        const std::string path =
+            (fs::path(dir) / format("annotate_%s_%04d_%d.png", objectName().c_str(), frame_,
+                                    shots_++)).string();
+        writeAtomically(path, [&](const String& tmp) {
+            // The temporary name keeps no image extension: encode explicitly.
+            std::vector<uchar> buf;
+            imencode(".png", canvas_, buf);
+            FILE* f = std::fopen(tmp.c_str(), "wb");
+            if (!f || std::fwrite(buf.data(), 1, buf.size(), f) != buf.size())
+            {
+                if (f)
+                    std::fclose(f);
+                CV_Error(Error::StsError, "cannot write " + path);
+            }
+            std::fclose(f);
+        });
+        status_ = "screenshot " + path;
+        info(g_, "annotate: " + status_);
+    }
+
+    // ---- drawing ------------------------------------------------------------------------------
+
+    void render()
+    {
+        dirty_ = false;
+        const int W = frameSize_.width, H = frameSize_.height;
+        canvas_.create(H + kStatusHeight + kTimelineHeight, W, CV_8UC3);
+        canvas_.setTo(Scalar(32, 32, 32));
+        Mat view = canvas_(Rect(0, 0, W, H));
+        image_.copyTo(view);
+        // Other objects' silhouettes of this frame, as thin outlines for context.
+        for (size_t o = 0; o < objects_.size(); ++o)
+        {
+            if (int(o) == object_)
+                continue;
+            auto it = masks_[objects_[o]].find(frame_);
+            if (it == masks_[objects_[o]].end())
+                continue;
+            std::vector<std::vector<Point>> cs;
+            findContours(it->second.clone(), cs, RETR_EXTERNAL, CHAIN_APPROX_SIMPLE);
+            drawContours(view, cs, -1, Scalar(200, 120, 120), 1, LINE_8);
+        }
+        const Point cur = dragContour_ >= 0 ? Point(-1, -1) : cursor_;
+        editor_->drawOverlay(view, cur);
+        if (dragContour_ >= 0 && cursor_.x >= 0)
+            circle(view, cursor_, 4, Scalar(0, 0, 255), 1, LINE_AA);
+        if (help_)
+            drawHelp(view);
+
+        const bool isKey = keyMarks_[objectName()].count(frame_) > 0;
+        const bool hasMask = masks_[objectName()].count(frame_) > 0;
+        const std::string line1 = format(
+            "frame %d/%d%s  object %s (%d/%d)  %s  anchors %d%s", frame_, frameCount_ - 1,
+            isKey ? (hasMask ? "  KEY (annotated)" : "  KEY (to do)") : "", objectName().c_str(),
+            object_ + 1, int(objects_.size()),
+            mode_ == SilhouetteEditor::LIVE_WIRE ? "LIVE WIRE" : "STRAIGHT",
+            editor_->getAnchorCount(), modified_ ? "  *" : "");
+        const std::string line2 = status_.empty() ? std::string("h: help   q: save and quit")
+                                                  : status_;
+        putText(canvas_, line1, Point(6, H + 18), FONT_HERSHEY_SIMPLEX, 0.45,
+                Scalar(230, 230, 230), 1, LINE_AA);
+        putText(canvas_, line2, Point(6, H + 38), FONT_HERSHEY_SIMPLEX, 0.45,
+                Scalar(150, 220, 255), 1, LINE_AA);
+        drawTimeline(canvas_(Rect(0, H + kStatusHeight, W, kTimelineHeight)));
+        imshow(kWindow, canvas_);
+    }
+
+    void drawTimeline(Mat strip)
+    {
+        const int W = strip.cols;
+        auto xOf = [&](int f) {
+            return frameCount_ > 1 ? int(std::lround(double(f) * (W - 1) / (frameCount_ - 1)))
+                                   : 0;
+        };
+        for (int f : keyMarks_[objectName()])
+        {
+            const bool done = masks_[objectName()].count(f) > 0;
+            rectangle(strip, Rect(xOf(f) - 1, 0, 3, strip.rows),
+                      done ? Scalar(0, 200, 0) : Scalar(0, 0, 230), FILLED);
+        }
+        line(strip, Point(xOf(frame_), 0), Point(xOf(frame_), strip.rows - 1),
+             Scalar(255, 255, 255), 1);
+    }
+
+    void drawHelp(Mat view)
+    {
+        const int n = int(sizeof(kHelp) / sizeof(kHelp[0]));
+        const int lineH = 17;
+        const Rect box = Rect(8, 8, std::min(view.cols - 16, 560), n * lineH + 14) &
+                         Rect(Point(), view.size());
+        Mat roi = view(box);
+        Mat dark(roi.size(), roi.type(), Scalar(20, 20, 20));
+        addWeighted(roi, 0.25, dark, 0.75, 0, roi);
+        for (int i = 0; i < n; ++i)
+        {
+            const Point at(box.x + 8, box.y + 18 + i * lineH);
+            putText(view, kHelp[i][0], at, FONT_HERSHEY_SIMPLEX, 0.42, Scalar(150, 220, 255), 1,
+                    LINE_AA);
+            putText(view, kHelp[i][1], at + Point(120, 0), FONT_HERSHEY_SIMPLEX, 0.42,
+                    Scalar(240, 240, 240), 1, LINE_AA);
+        }
+    }
+
+    Options opt_;
+    const Globals& g_;
+    Ptr<FrameSource> source_;
+    int frameCount_ = 0;
+    Size frameSize_;
+    ObjectMasks masks_;
+    std::vector<std::string> objects_;
+    std::map<std::string, std::set<int>> keyMarks_;
+    std::map<std::pair<int, int>, Ptr<SilhouetteEditor>> editors_;
+    Ptr<SilhouetteEditor> editor_;
+    Mat image_, canvas_;
+    int object_ = 0, frame_ = 0;
+    int mode_ = SilhouetteEditor::LIVE_WIRE;
+    Point cursor_ = Point(-1, -1);
+    int dragContour_ = -1, dragAnchor_ = -1;
+    bool dirty_ = true, help_ = false, modified_ = false;
+    int shots_ = 0;
+    std::string status_;
+};
+
+} // namespace
+
+void registerAnnotate(CLI::App& app, Globals& g)
+{
+    auto opt = std::make_shared<Options>();
+    CLI::App* sub = app.add_subcommand(
+        "annotate", "trace silhouettes of real objects in key frames (interactive window; "
+                    "Intelligent Scissors live wire and straight segments)");
+    sub->add_option("--input", opt->input, "video, image folder or printf pattern")->required();
+    sub->add_option("--masks", opt->masks,
+                    "masks folder MASKS/<object>/%04d.png (read if present, written on save)")
+        ->required();
+    sub->add_option("--object", opt->objects, "object name(s) to trace (repeatable)");
+    sub->add_option("--frame", opt->frame, "frame to start at (default 0)");
+    sub->add_option("--tracks", opt->tracks, "tracks.yml for key-frame suggestions");
+    sub->add_option("--reconstruction", opt->reconstruction,
+                    "reconstruction.yml for key-frame suggestions");
+    sub->add_option("--suggest", opt->suggest,
+                    "mark this many suggested key frames (needs --tracks and/or "
+                    "--reconstruction)");
+    sub->add_option("--screenshot-dir", opt->screenshotDir,
+                    "where the w key saves screenshots (default: beside MASKS)");
+    sub->callback([opt, &g]() {
+        requireFile("--input", opt->input);
+        if (!opt->tracks.empty())
+            requireFile("--tracks", opt->tracks);
+        if (!opt->reconstruction.empty())
+            requireFile("--reconstruction", opt->reconstruction);
+        if (opt->suggest < 0)
+            throw UsageError("--suggest must be >= 0");
+        AnnotateApp app(*opt, g);
+        app.run();
+    });
 }
 
 } // namespace augocc_cli

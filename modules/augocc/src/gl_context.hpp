@@ -11,6 +11,8 @@ namespace cv {
 namespace augocc {
 namespace detail {
 
+// Internal API, exported (CV_EXPORTS) only so that the tests and the perf suite can reach it.
+
 /** @brief Offscreen OpenGL through OSMesa (Mesa llvmpipe, compatibility profile), shared by the
 synthesizer and the compositor. No display is needed.
 
@@ -18,7 +20,7 @@ The context renders into an RGBA8 buffer with a 24-bit depth buffer. It is curre
 that created it or called makeCurrent() last (OSMesa contexts are per thread). gl* calls must bind
 to libOSMesa: never link libGL into the library or the CLI (PITFALLS.md).
 */
-class GlContext
+class CV_EXPORTS GlContext
 {
 public:
     //! Creates a context of the given size; throws StsError when OSMesa fails.
@@ -52,15 +54,15 @@ contract's pixel convention exactly (pixel (0,0) centre = window (0.5, H - 0.5))
 increasing with camera-space z, near/far at zNear/zFar (camera-space z). The camera looks along +z
 (the contract), so use glDepthFunc(GL_LESS) and no face culling, or cull with care: the y flip
 reverses winding. */
-Matx44d glProjection(const Camera& cam, Size imageSize, double zNear, double zFar);
+CV_EXPORTS Matx44d glProjection(const Camera& cam, Size imageSize, double zNear, double zFar);
 
 //! World-to-camera 4x4 of a camera (row-major).
-Matx44d glModelView(const Camera& cam);
+CV_EXPORTS Matx44d glModelView(const Camera& cam);
 
 /** @brief Converts window depth d in [0, 1] read back from a buffer rendered with
 glProjection(cam, ..., zNear, zFar) into camera-space z. d == 1 (the cleared far plane) becomes
 +infinity. */
-void windowDepthToCameraZ(const Camera& cam, InputArray depth01, double zNear, double zFar,
+CV_EXPORTS void windowDepthToCameraZ(const Camera& cam, InputArray depth01, double zNear, double zFar,
                           OutputArray z);
 
 } // namespace detail

@@ -590,7 +590,7 @@ private:
     void open()
     {
         cap_.release();
-        if (!cap_.open(path_, CAP_FFMPEG) && !cap_.open(path_, CAP_ANY))
+        if (!cap_.open(path_, CAP_FFMPEG))
             CV_Error(Error::StsParseError, path_ + ": cannot open as a video (corrupt or "
                      "unsupported format)");
         pos_ = 0;

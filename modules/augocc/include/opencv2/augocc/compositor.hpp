@@ -4,6 +4,115 @@
 #ifndef OPENCV_AUGOCC_COMPOSITOR_HPP
 #define OPENCV_AUGOCC_COMPOSITOR_HPP
 
+#include <vector>
 #include <opencv2/core.hpp>
+#include "opencv2/augocc/camera.hpp"
+#include "opencv2/augocc/clone_builder.hpp"
+#include "opencv2/augocc/mesh.hpp"
+
+namespace cv {
+namespace augocc {
+
+//! @addtogroup augocc
+//! @{
+
+/** @brief The camera of the same view on a pixel grid `factor` times finer.
+
+Pixel centres follow the contract (origin at the centre of the top-left pixel): pixel (u, v) of
+the original grid covers the `factor` x `factor` block whose centres are
+`factor * (u + 0.5) - 0.5 +- ...`, so s (or fx, fy, skew) is multiplied by `factor` and the
+principal point becomes `factor * (c + 0.5) - 0.5`. Rendering with the returned camera at
+`factor` times the size and box-averaging down gives an anti-aliased image of the original view.
+*/
+CV_EXPORTS Camera supersampledCamera(const Camera& camera, int factor);
+
+/** @brief Inserts virtual objects into frames of a real scene so that real objects hide them
+(the paper's Section 7), headless through OSMesa.
+
+Per frame: the video frame is the background; the clones of the real objects go into the depth
+buffer only; the virtual objects are drawn with the depth test and simple lighting (ambient plus
+one directional light, per-vertex normals, material colour and diffuse texture: the convention of
+the SceneSynthesizer). Depth is camera-space z in every camera model, so clones and virtual objects
+compare in one metric. The virtual camera is the frame's reconstructed camera.
+
+Soft occlusion edges: with Params::supersample = k > 1 the virtual layer is rendered against the
+clone depth at k times the frame size and box-averaged down, so a pixel that a real object covers
+in part gets the matching fraction of the virtual object (and the virtual objects' own outlines
+are anti-aliased). k = 1 is the paper's hard per-pixel depth test.
+
+One OpenGL context is created on first use and reused for every frame; meshes are uploaded once
+into vertex buffer objects. A Compositor must be used from one thread (OSMesa contexts are per
+thread); it is not itself parallel, but its CPU stages use cv::parallel_for_.
+*/
+class CV_EXPORTS Compositor : public Algorithm
+{
+public:
+    struct CV_EXPORTS Params
+    {
+        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
+        /** Supersampling factor of the virtual layer and the occluder depth (default 3). 1 gives
+        the paper's hard depth test; 3 makes occlusion edges soft (see doc/compositor.md for the
+        measured error). */
+        int supersample;
+        /** Cull the back faces of meshes that are closed and outward-oriented (checked per mesh
+        when uploaded; such back faces are never visible, so no pixel changes). Halves the
+        triangles the rasteriser sets up (default true). */
+        bool cullBackFaces;
+    };
+
+    static Ptr<Compositor> create(const Params& params);
+    //! Creates a compositor with default Params.
+    static Ptr<Compositor> create();
+    virtual Params getParams() const = 0;
+    //! Throws StsBadArg on supersample < 1 or > 8.
+    virtual void setParams(const Params& params) = 0;
+
+    /** @brief Sets the virtual objects, in the world frame of the reconstruction. The meshes are
+    copied, lit once (the light is fixed in the world: the shading convention of src/shading.hpp,
+    base * (ambient + diffuse * max(0, n.L)), times the texture) and uploaded to the GPU on the
+    next frame. Meshes without normals get smooth normals. An empty list composites nothing.
+    Throws StsBadArg on a face index out of range. */
+    virtual void setVirtualObjects(const std::vector<Mesh>& meshes) = 0;
+
+    //! Size at which composite() wants the occluder depth: frameSize * supersample.
+    virtual Size renderSize(Size frameSize) const = 0;
+
+    /** @brief Composites one frame given the depth of the real occluders.
+    @param frame the video frame, BGR CV_8UC3.
+    @param camera the frame's camera (frame size grid).
+    @param occluderDepth CV_32F camera-space z of the real objects (+inf where none), either at
+    renderSize(frame.size()) (soft edges) or at the frame size (nearest-upsampled, hard edges).
+    Empty: nothing occludes.
+    @param result output BGR CV_8UC3, the frame with the virtual objects inserted.
+    @param virtualLayer optional output BGRA CV_8UC4: the visible virtual objects with straight
+    (not premultiplied) alpha = their coverage; result = frame * (1 - a) + layer * a.
+    @param depth optional output CV_32F at the frame size: camera-space z of the nearest of the
+    occluders and the virtual objects (the minimum over each pixel's samples), +inf where none.
+    */
+    virtual void composite(InputArray frame, const Camera& camera, InputArray occluderDepth,
+                           OutputArray result, OutputArray virtualLayer = noArray(),
+                           OutputArray depth = noArray()) = 0;
+
+    /** @brief Composites one frame with the clones of the real objects as occluders: every
+    clone is rendered at renderSize() with supersampledCamera(), with the patch set of `frameIndex`,
+    and the nearest clone surface is the occluder depth.
+    @param frame the video frame, BGR CV_8UC3.
+    @param frameIndex frame index (selects the clones' patch sets).
+    @param camera the frame's camera.
+    @param clones the clones.
+    @param result output BGR CV_8UC3.
+    @param virtualLayer optional output, see the other overload.
+    @param depth optional output, see the other overload.
+    */
+    virtual void composite(InputArray frame, int frameIndex, const Camera& camera,
+                           const CloneSet& clones, OutputArray result,
+                           OutputArray virtualLayer = noArray(),
+                           OutputArray depth = noArray()) = 0;
+};
+
+//! @}
+
+} // namespace augocc
+} // namespace cv
 
 #endif

@@ -1,0 +1,145 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#ifndef OPENCV_AUGOCC_SCENE_HPP
+#define OPENCV_AUGOCC_SCENE_HPP
+
+#include <vector>
+#include <opencv2/core.hpp>
+#include "opencv2/augocc/camera.hpp"
+#include "opencv2/augocc/clone_builder.hpp"
+#include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/mesh.hpp"
+
+/*
+The scene file (scene.yml, a cv::FileStorage YAML/JSON file; format in doc/compositor.md): the
+virtual objects to insert, each a mesh file or a procedural shape, placed either by position,
+rotation and scale in the reconstruction's world frame, or relative to what the user sees: on the
+ground beside a real object's clone, behind it or in front of it by a distance in clone sizes.
+
+Ground coordinates (GroundFrame): x to the right of the mean view, y up (height above the ground),
+z back towards the viewer; right-handed; origin on the ground plane below the world origin.
+*/
+
+namespace cv {
+namespace augocc {
+
+//! @addtogroup augocc
+//! @{
+
+//! One virtual object of a scene file, as parsed (object coordinates, y up for the helpers).
+struct CV_EXPORTS SceneObject
+{
+    //! How the object is placed.
+    enum Placement
+    {
+        PLACE_ABSOLUTE = 0,   //!< `position` in the reconstruction's world frame
+        PLACE_BESIDE = 1,     //!< `on_ground_beside: <clone>`
+        PLACE_BEHIND = 2,     //!< `behind: <clone>`
+        PLACE_IN_FRONT = 3    //!< `in_front_of: <clone>`
+    };
+
+    String name;                         //!< object name (default object_<i>)
+    String shape;                        //!< procedural shape (dome, tree, box...) or empty
+    String meshFile;                     //!< mesh file (resolved against the scene's folder) or empty
+    std::vector<Mesh> meshes;            //!< loaded geometry, object coordinates
+    int placement = PLACE_ABSOLUTE;      //!< Placement
+    Vec3d position = Vec3d(0, 0, 0);     //!< PLACE_ABSOLUTE: world position of the object origin
+    Vec3d rotationDeg = Vec3d(0, 0, 0);  //!< Euler angles in degrees, R = Rz * Ry * Rx
+    Vec3d scale = Vec3d(1, 1, 1);        //!< per-axis scale (object coordinates)
+    double size = 0;                     //!< helpers: largest dimension in clone sizes (0: keep)
+    String anchor;                       //!< helpers: the clone object placed against
+    double distance = 0.25;              //!< helpers: gap to the clone in clone sizes
+    int side = 1;                        //!< PLACE_BESIDE: +1 right, -1 left (as seen)
+    Vec3d offset = Vec3d(0, 0, 0);       //!< helpers: extra shift, ground axes, clone sizes
+};
+
+//! A parsed scene file.
+struct CV_EXPORTS VirtualScene
+{
+    String path;                        //!< the file it came from
+    std::vector<SceneObject> objects;
+};
+
+/** @brief Reads and validates a scene file; loads its meshes (files relative to the scene file's
+folder, or procedural). Throws StsParseError naming the file and the key for an unknown key, a
+wrong value type, a missing mesh/shape, an unknown clone placement or shape; mesh errors are
+loadMeshes()'s.
+@param path scene.yml (FileStorage YAML or JSON).
+*/
+CV_EXPORTS VirtualScene readScene(const String& path);
+
+/** @brief Writes a scene file that readScene() reads back (meshes are referenced, not written);
+atomic. */
+CV_EXPORTS void writeScene(const String& path, const VirtualScene& scene);
+
+/** @brief The procedural shapes of scene files: unit size, base on y = 0, centred on the y axis.
+`dome` (radius 1), `tree` (trunk and cone of foliage, height 1), `box` (unit cube), `sphere`,
+`cylinder`, `cone` (diameter 1, height 1). Throws StsBadArg on an unknown name.
+@return one mesh per material (a tree has two).
+*/
+CV_EXPORTS std::vector<Mesh> proceduralShape(const String& shape);
+
+/** @brief Where "up" and the ground are in a reconstruction (whose world frame is the first
+camera's for a factorization, so up is unknown a priori).
+
+Up: the cameras of a hand-held or orbiting shot have horizontal image x axes (no roll), so up is
+the direction most orthogonal to all of them (least eigenvector of sum x x^T), signed to agree with
+the cameras' mean image-up vector; when the x axes do not span the horizontal (a camera that never
+turns about the vertical) it is the mean image-up vector. Ground: a RANSAC plane through the
+reconstructed points whose normal lies within 15 degrees of that up, among the lowest half of the
+points; when found it refines up and gives the height. Otherwise the ground is the 2nd percentile
+of the points' heights (or 0 without points).
+*/
+struct CV_EXPORTS GroundFrame
+{
+    Vec3d up = Vec3d(0, 1, 0);        //!< unit up, world frame
+    Vec3d right = Vec3d(1, 0, 0);     //!< unit, horizontal, right of the mean view direction
+    Vec3d back = Vec3d(0, 0, 1);      //!< unit, horizontal, towards the viewer (right x up)
+    double height = 0;                //!< ground plane: up . X == height
+    bool fromPlane = false;           //!< true when a ground plane was fitted to points
+
+    //! World point to ground coordinates (right, up above the ground, back).
+    Vec3d toGround(const Vec3d& Xw) const;
+    //! Ground coordinates to a world point.
+    Vec3d fromGround(const Vec3d& g) const;
+};
+
+//! @brief Estimates the ground frame of a reconstruction (see GroundFrame).
+CV_EXPORTS GroundFrame estimateGround(const Reconstruction& rec);
+
+/** @brief Bounds of a clone in ground coordinates, from the clone surfaces seen in a few frames
+(rendered depth unprojected to world points: first, middle and last camera).
+@param clones the clones.
+@param object object name.
+@param rec the reconstruction (cameras, image size).
+@param ground the ground frame.
+@param minCorner output minimum (right, up, back).
+@param maxCorner output maximum.
+Throws StsObjectNotFound when the object is unknown or its clone is seen in no frame.
+*/
+CV_EXPORTS void estimateCloneBounds(const CloneSet& clones, const String& object,
+                                    const Reconstruction& rec, const GroundFrame& ground,
+                                    Vec3d& minCorner, Vec3d& maxCorner);
+
+/** @brief Places the objects of a scene: returns their meshes in the reconstruction's world
+frame (one per material), ready for Compositor::setVirtualObjects().
+@param scene the parsed scene.
+@param rec the reconstruction.
+@param clones the clones (needed by the placement helpers; may be null when none is used).
+Throws StsBadArg naming the scene file and object when a helper names an unknown clone or no
+clones are given.
+*/
+CV_EXPORTS std::vector<Mesh> placeScene(const VirtualScene& scene, const Reconstruction& rec,
+                                        const CloneSet* clones);
+
+//! @brief Model matrix (object to world) of each object, as placeScene() computes it.
+CV_EXPORTS std::vector<Matx44d> scenePoses(const VirtualScene& scene, const Reconstruction& rec,
+                                           const CloneSet* clones);
+
+//! @}
+
+} // namespace augocc
+} // namespace cv
+
+#endif

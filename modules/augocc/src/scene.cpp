@@ -1,0 +1,611 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// Scene files (virtual objects and where they go), the ground frame of a reconstruction and the
+// placement helpers that put objects relative to the clones of what the user sees.
+
+#include "precomp.hpp"
+
+#include <filesystem>
+#include <set>
+#include <opencv2/imgcodecs.hpp>
+
+namespace fs = std::filesystem;
+
+namespace cv {
+namespace augocc {
+
+namespace {
+
+const char* const kObjectKeys[] = {"name", "mesh", "shape", "position", "rotation", "scale",
+                                   "size", "material", "on_ground_beside", "behind",
+                                   "in_front_of", "distance", "side", "offset"};
+const char* const kMaterialKeys[] = {"diffuse", "ambient", "texture"};
+
+[[noreturn]] void sceneError(const String& file, const String& where, const String& what)
+{
+    CV_Error(Error::StsParseError, file + ": " + where + ": " + what);
+}
+
+bool isNumber(const FileNode& n)
+{
+    return n.isReal() || n.isInt();
+}
+
+double readNumber(const FileNode& n, const String& file, const String& where)
+{
+    if (!isNumber(n))
+        sceneError(file, where, "expected a number");
+    const double v = (double)n;
+    if (!std::isfinite(v))
+        sceneError(file, where, "value is not finite");
+    return v;
+}
+
+Vec3d readVec3(const FileNode& n, const String& file, const String& where)
+{
+    if (!n.isSeq() || n.size() != 3)
+        sceneError(file, where, "expected a sequence of three numbers, e.g. [1, 2, 3]");
+    Vec3d v;
+    for (int k = 0; k < 3; k++)
+        v[k] = readNumber(n[k], file, where);
+    return v;
+}
+
+String readString(const FileNode& n, const String& file, const String& where)
+{
+    if (!n.isString())
+        sceneError(file, where, "expected a string");
+    const String s = (String)n;
+    if (s.empty())
+        sceneError(file, where, "empty string");
+    return s;
+}
+
+void checkKeys(const FileNode& map, const char* const* keys, size_t nkeys, const String& file,
+               const String& where)
+{
+    if (!map.isMap())
+        sceneError(file, where, "expected a map of keys");
+    const std::set<String> allowed(keys, keys + nkeys);
+    for (const String& k : map.keys())
+        if (!allowed.count(k))
+            sceneError(file, where, "unknown key '" + k + "'");
+}
+
+Vec3f readColor(const FileNode& n, const String& file, const String& where)
+{
+    const Vec3d c = readVec3(n, file, where);
+    for (int k = 0; k < 3; k++)
+        if (c[k] < 0 || c[k] > 1)
+            sceneError(file, where, "colour components must be in [0, 1]");
+    return Vec3f(c);
+}
+
+Matx33d eulerDeg(const Vec3d& deg)
+{
+    const double d2r = CV_PI / 180.0;
+    const double ax = deg[0] * d2r, ay = deg[1] * d2r, az = deg[2] * d2r;
+    const Matx33d Rx(1, 0, 0, 0, std::cos(ax), -std::sin(ax), 0, std::sin(ax), std::cos(ax));
+    const Matx33d Ry(std::cos(ay), 0, std::sin(ay), 0, 1, 0, -std::sin(ay), 0, std::cos(ay));
+    const Matx33d Rz(std::cos(az), -std::sin(az), 0, std::sin(az), std::cos(az), 0, 0, 0, 1);
+    return Rz * Ry * Rx;
+}
+
+Matx44d affine(const Matx33d& A, const Vec3d& t)
+{
+    return Matx44d(A(0, 0), A(0, 1), A(0, 2), t[0], A(1, 0), A(1, 1), A(1, 2), t[1],
+                   A(2, 0), A(2, 1), A(2, 2), t[2], 0, 0, 0, 1);
+}
+
+Mesh colored(Mesh m, const Vec3f& rgb)
+{
+    m.material.diffuse = rgb;
+    m.material.ambient = rgb * 0.35f;
+    return m;
+}
+
+} // namespace
+
+std::vector<Mesh> proceduralShape(const String& shape)
+{
+    // Unit size, base on y = 0. Colours after the paper's Fig. 3 (a pale dome, a green tree).
+    const Vec3f grey(0.75f, 0.75f, 0.75f);
+    if (shape == "dome")
+        return {colored(Mesh::dome(1.f, 48, 16), Vec3f(0.92f, 0.86f, 0.72f))};
+    if (shape == "tree")
+        return {colored(Mesh::cylinder(0.07f, 0.f, 0.35f, 16), Vec3f(0.45f, 0.30f, 0.15f)),
+                colored(Mesh::cone(0.3f, 0.25f, 1.f, 32), Vec3f(0.18f, 0.55f, 0.20f))};
+    if (shape == "box")
+        return {colored(Mesh::box(Vec3f(-0.5f, 0.f, -0.5f), Vec3f(0.5f, 1.f, 0.5f)), grey)};
+    if (shape == "sphere")
+    {
+        Mesh m = Mesh::sphere(0.5f, 32, 16);
+        m.transform(affine(Matx33d::eye(), Vec3d(0, 0.5, 0)));
+        return {colored(m, grey)};
+    }
+    if (shape == "cylinder")
+        return {colored(Mesh::cylinder(0.5f, 0.f, 1.f, 32), grey)};
+    if (shape == "cone")
+        return {colored(Mesh::cone(0.5f, 0.f, 1.f, 32), grey)};
+    CV_Error(Error::StsBadArg, "unknown shape '" + shape + "' (dome, tree, box, sphere, "
+             "cylinder, cone)");
+}
+
+VirtualScene readScene(const String& path)
+{
+    if (!fs::is_regular_file(path))
+        CV_Error(Error::StsObjectNotFound, path + ": scene file not found");
+    FileStorage fsIn;
+    try
+    {
+        fsIn.open(path, FileStorage::READ);
+    }
+    catch (const cv::Exception& e)
+    {
+        CV_Error(Error::StsParseError, path + ": cannot parse scene file: " + e.err);
+    }
+    if (!fsIn.isOpened())
+        CV_Error(Error::StsParseError, path + ": cannot parse scene file");
+    const FileNode root = fsIn.root();
+    const char* const rootKeys[] = {"objects"};
+    checkKeys(root, rootKeys, 1, path, "top level");
+    const FileNode objs = root["objects"];
+    if (objs.empty() || !objs.isSeq() || objs.size() == 0)
+        sceneError(path, "objects", "missing or empty: expected a sequence of objects");
+
+    VirtualScene scene;
+    scene.path = path;
+    const fs::path dir = fs::path(path).parent_path();
+    std::set<String> names;
+    for (int i = 0; i < (int)objs.size(); i++)
+    {
+        const FileNode o = objs[i];
+        const String where = cv::format("objects[%d]", i);
+        checkKeys(o, kObjectKeys, sizeof(kObjectKeys) / sizeof(kObjectKeys[0]), path, where);
+        SceneObject so;
+        so.name = o["name"].empty() ? cv::format("object_%d", i)
+                                    : readString(o["name"], path, where + ".name");
+        if (!names.insert(so.name).second)
+            sceneError(path, where + ".name", "duplicate object name '" + so.name + "'");
+        const bool hasMesh = !o["mesh"].empty(), hasShape = !o["shape"].empty();
+        if (hasMesh == hasShape)
+            sceneError(path, where, "give exactly one of 'mesh' (a file) or 'shape' (dome, tree, "
+                       "box, sphere, cylinder, cone)");
+        if (hasShape)
+        {
+            so.shape = readString(o["shape"], path, where + ".shape");
+            try
+            {
+                so.meshes = proceduralShape(so.shape);
+            }
+            catch (const cv::Exception& e)
+            {
+                sceneError(path, where + ".shape", e.err);
+            }
+        }
+        else
+        {
+            const String rel = readString(o["mesh"], path, where + ".mesh");
+            so.meshFile = fs::path(rel).is_absolute() ? rel : (dir / rel).string();
+            so.meshes = loadMeshes(so.meshFile);
+        }
+        if (!o["rotation"].empty())
+            so.rotationDeg = readVec3(o["rotation"], path, where + ".rotation");
+        if (!o["scale"].empty())
+        {
+            const FileNode s = o["scale"];
+            so.scale = s.isSeq() ? readVec3(s, path, where + ".scale")
+                                 : Vec3d::all(readNumber(s, path, where + ".scale"));
+            for (int k = 0; k < 3; k++)
+                if (!(so.scale[k] > 0))
+                    sceneError(path, where + ".scale", "scale must be positive");
+        }
+        int helpers = 0;
+        const std::pair<const char*, int> helperKeys[] = {
+            {"on_ground_beside", SceneObject::PLACE_BESIDE},
+            {"behind", SceneObject::PLACE_BEHIND},
+            {"in_front_of", SceneObject::PLACE_IN_FRONT}};
+        for (const auto& hk : helperKeys)
+            if (!o[hk.first].empty())
+            {
+                so.anchor = readString(o[hk.first], path, where + "." + hk.first);
+                so.placement = hk.second;
+                helpers++;
+            }
+        if (helpers > 1)
+            sceneError(path, where, "give at most one of on_ground_beside, behind, in_front_of");
+        const bool hasPosition = !o["position"].empty();
+        if (hasPosition && helpers)
+            sceneError(path, where, "'position' and a placement helper exclude each other");
+        if (hasPosition)
+            so.position = readVec3(o["position"], path, where + ".position");
+        if (!helpers)
+        {
+            for (const char* k : {"distance", "side", "offset", "size"})
+                if (!o[k].empty())
+                    sceneError(path, where + "." + k, "only valid with on_ground_beside, behind "
+                               "or in_front_of");
+        }
+        else
+        {
+            if (!o["distance"].empty())
+                so.distance = readNumber(o["distance"], path, where + ".distance");
+            if (!o["offset"].empty())
+                so.offset = readVec3(o["offset"], path, where + ".offset");
+            if (!o["size"].empty())
+            {
+                so.size = readNumber(o["size"], path, where + ".size");
+                if (!(so.size > 0))
+                    sceneError(path, where + ".size", "size must be positive");
+            }
+            if (!o["side"].empty())
+            {
+                if (so.placement != SceneObject::PLACE_BESIDE)
+                    sceneError(path, where + ".side", "only valid with on_ground_beside");
+                const String side = readString(o["side"], path, where + ".side");
+                if (side != "left" && side != "right")
+                    sceneError(path, where + ".side", "expected 'left' or 'right'");
+                so.side = side == "left" ? -1 : 1;
+            }
+        }
+        if (!o["material"].empty())
+        {
+            const FileNode m = o["material"];
+            checkKeys(m, kMaterialKeys, 3, path, where + ".material");
+            for (Mesh& mesh : so.meshes)
+            {
+                if (!m["diffuse"].empty())
+                {
+                    mesh.material.diffuse = readColor(m["diffuse"], path, where + ".material.diffuse");
+                    mesh.colors.clear();
+                }
+                if (!m["ambient"].empty())
+                    mesh.material.ambient = readColor(m["ambient"], path, where + ".material.ambient");
+                if (!m["texture"].empty())
+                {
+                    const String rel = readString(m["texture"], path, where + ".material.texture");
+                    const String file = fs::path(rel).is_absolute() ? rel : (dir / rel).string();
+                    Mat tex = cv::imread(file, IMREAD_COLOR);
+                    if (tex.empty())
+                        sceneError(path, where + ".material.texture", file + ": cannot read image");
+                    mesh.material.texture = tex;
+                }
+            }
+        }
+        scene.objects.push_back(std::move(so));
+    }
+    return scene;
+}
+
+void writeScene(const String& path, const VirtualScene& scene)
+{
+    writeAtomically(path, [&](const String& tmp) {
+        FileStorage out(tmp, FileStorage::WRITE);
+        if (!out.isOpened())
+            CV_Error(Error::StsError, path + ": cannot open for writing");
+        const fs::path dir = fs::path(path).parent_path();
+        out << "objects" << "[";
+        for (const SceneObject& o : scene.objects)
+        {
+            out << "{";
+            out << "name" << o.name;
+            if (!o.shape.empty())
+                out << "shape" << o.shape;
+            else
+            {
+                std::error_code ec;
+                const fs::path rel = fs::relative(o.meshFile, dir.empty() ? "." : dir, ec);
+                out << "mesh" << (ec || rel.empty() ? o.meshFile : rel.string());
+            }
+            const char* helper = o.placement == SceneObject::PLACE_BESIDE ? "on_ground_beside"
+                                 : o.placement == SceneObject::PLACE_BEHIND ? "behind"
+                                 : o.placement == SceneObject::PLACE_IN_FRONT ? "in_front_of"
+                                                                            : nullptr;
+            if (helper)
+            {
+                out << helper << o.anchor << "distance" << o.distance;
+                if (o.placement == SceneObject::PLACE_BESIDE)
+                    out << "side" << (o.side < 0 ? "left" : "right");
+                if (o.size > 0)
+                    out << "size" << o.size;
+                out << "offset" << "[:" << o.offset[0] << o.offset[1] << o.offset[2] << "]";
+            }
+            else
+                out << "position" << "[:" << o.position[0] << o.position[1] << o.position[2]
+                    << "]";
+            out << "rotation" << "[:" << o.rotationDeg[0] << o.rotationDeg[1]
+                << o.rotationDeg[2] << "]";
+            out << "scale" << "[:" << o.scale[0] << o.scale[1] << o.scale[2] << "]";
+            out << "}";
+        }
+        out << "]";
+        out.release();
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Ground frame
+
+Vec3d GroundFrame::toGround(const Vec3d& X) const
+{
+    return Vec3d(right.dot(X), up.dot(X) - height, back.dot(X));
+}
+
+Vec3d GroundFrame::fromGround(const Vec3d& g) const
+{
+    return right * g[0] + up * (g[1] + height) + back * g[2];
+}
+
+namespace {
+
+// Eigen-decomposition helper: eigenvector of the smallest eigenvalue of a symmetric 3x3.
+Vec3d leastEigenvector(const Matx33d& S)
+{
+    Mat evals, evecs;
+    cv::eigen(Mat(S), evals, evecs);  // descending
+    return Vec3d(evecs.at<double>(2, 0), evecs.at<double>(2, 1), evecs.at<double>(2, 2));
+}
+
+} // namespace
+
+GroundFrame estimateGround(const Reconstruction& rec)
+{
+    if (rec.cameras.empty())
+        CV_Error(Error::StsBadArg, "estimateGround: the reconstruction has no camera");
+    // Up from the cameras: image x axes are horizontal (no roll), image up (-y) roughly up.
+    Matx33d S = Matx33d::zeros();
+    Vec3d meanUp(0, 0, 0), meanView(0, 0, 0);
+    for (const Camera& c : rec.cameras)
+    {
+        const Vec3d x(c.R(0, 0), c.R(0, 1), c.R(0, 2));
+        S += x * x.t();
+        meanUp -= Vec3d(c.R(1, 0), c.R(1, 1), c.R(1, 2));
+        meanView += c.viewDirection();
+    }
+    meanUp = cv::normalize(meanUp);
+    // The x axes must span a plane (the camera turned about the vertical): the middle eigenvalue
+    // of sum x x^T is then well above the smallest. 1e-3 of the largest is a turn of about 6
+    // degrees over the shot; 20x the smallest keeps noisy axes (0.3 deg ~ 3e-5) from deciding.
+    const double kMinSpanRatio = 1e-3, kMinSeparation = 20.0;
+    Mat evals, evecs;
+    cv::eigen(Mat(S), evals, evecs);  // descending
+    Vec3d up(evecs.at<double>(2, 0), evecs.at<double>(2, 1), evecs.at<double>(2, 2));
+    const double l0 = evals.at<double>(0), l1 = evals.at<double>(1), l2 = evals.at<double>(2);
+    if (!(l1 > kMinSpanRatio * l0 && l1 > kMinSeparation * std::max(l2, 0.0)))
+        up = meanUp;
+    if (up.dot(meanUp) < 0)
+        up = -up;
+
+    GroundFrame g;
+    // Ground plane from the points.
+    std::vector<Vec3d> pts;
+    if (!rec.points.empty())
+        for (int i = 0; i < rec.points.rows; i++)
+        {
+            const double* p = rec.points.ptr<double>(i);
+            if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
+                pts.push_back(Vec3d(p[0], p[1], p[2]));
+        }
+    double height = 0;
+    bool fromPlane = false;
+    if (pts.size() >= 10)
+    {
+        std::vector<double> h(pts.size());
+        for (size_t i = 0; i < pts.size(); i++)
+            h[i] = up.dot(pts[i]);
+        std::vector<double> hs = h;
+        std::sort(hs.begin(), hs.end());
+        const double hMedian = hs[hs.size() / 2];
+        height = hs[(size_t)(0.02 * (hs.size() - 1))];
+        // Spread of the scene along up: the inlier band is 1% of it.
+        const double extent = std::max(hs.back() - hs.front(), 1e-12);
+        const double kInlierFraction = 0.01;
+        const double tol = kInlierFraction * extent;
+        const double kMaxTiltDeg = 15.0;
+        std::vector<Vec3d> low;
+        for (size_t i = 0; i < pts.size(); i++)
+            if (h[i] <= hMedian)
+                low.push_back(pts[i]);
+        // Deterministic RANSAC (fixed seed) over the lower half of the points.
+        RNG rng(0x5eed);
+        size_t bestCount = 0;
+        Vec3d bestN = up;
+        double bestD = height;
+        const int kIterations = 500;
+        for (int it = 0; it < kIterations && low.size() >= 3; it++)
+        {
+            const Vec3d& a = low[rng.uniform(0, (int)low.size())];
+            const Vec3d& b = low[rng.uniform(0, (int)low.size())];
+            const Vec3d& c = low[rng.uniform(0, (int)low.size())];
+            Vec3d n = (b - a).cross(c - a);
+            const double len = cv::norm(n);
+            if (!(len > 0))
+                continue;
+            n *= 1.0 / len;
+            if (n.dot(up) < 0)
+                n = -n;
+            if (n.dot(up) < std::cos(kMaxTiltDeg * CV_PI / 180))
+                continue;
+            const double d = n.dot(a);
+            size_t count = 0;
+            for (const Vec3d& p : pts)
+                if (std::abs(n.dot(p) - d) < tol)
+                    count++;
+            if (count > bestCount)
+            {
+                bestCount = count;
+                bestN = n;
+                bestD = d;
+            }
+        }
+        // A plane holds the ground when it carries a tenth of the points (at least 10).
+        const size_t kMinInliers = std::max<size_t>(10, pts.size() / 10);
+        if (bestCount >= kMinInliers)
+        {
+            // Least-squares refit on the inliers.
+            Vec3d centroid(0, 0, 0);
+            std::vector<Vec3d> in;
+            for (const Vec3d& p : pts)
+                if (std::abs(bestN.dot(p) - bestD) < tol)
+                    in.push_back(p);
+            for (const Vec3d& p : in)
+                centroid += p;
+            centroid *= 1.0 / in.size();
+            Matx33d C = Matx33d::zeros();
+            for (const Vec3d& p : in)
+                C += (p - centroid) * (p - centroid).t();
+            Vec3d n = leastEigenvector(C);
+            if (n.dot(up) < 0)
+                n = -n;
+            up = n;
+            height = n.dot(centroid);
+            fromPlane = true;
+        }
+    }
+    g.up = up;
+    g.height = height;
+    g.fromPlane = fromPlane;
+    // Horizontal mean view direction: "behind" is away from the viewer.
+    Vec3d f = meanView - up * up.dot(meanView);
+    if (cv::norm(f) < 1e-6)
+    {
+        // Looking straight down: "forward" is image up.
+        f = meanUp - up * up.dot(meanUp);
+    }
+    f = cv::normalize(f);
+    g.right = cv::normalize(f.cross(up));
+    g.back = -f;
+    return g;
+}
+
+void estimateCloneBounds(const CloneSet& clones, const String& object, const Reconstruction& rec,
+                         const GroundFrame& ground, Vec3d& minCorner, Vec3d& maxCorner)
+{
+    const std::vector<String> names = clones.objectNames();
+    if (std::find(names.begin(), names.end(), object) == names.end())
+        CV_Error(Error::StsObjectNotFound, "no clone named '" + object + "'");
+    CV_Assert(!rec.cameras.empty());
+    const int n = (int)rec.cameras.size();
+    std::set<int> which = {0, n / 2, n - 1};
+    minCorner = Vec3d::all(std::numeric_limits<double>::infinity());
+    maxCorner = -minCorner;
+    int seen = 0;
+    for (int idx : which)
+    {
+        const Camera& cam = rec.cameras[idx];
+        Mat matte, depth;
+        clones.render(object, cam.frame, cam, rec.imageSize, matte, depth);
+        for (int y = 0; y < depth.rows; y++)
+        {
+            const float* d = depth.ptr<float>(y);
+            for (int x = 0; x < depth.cols; x++)
+            {
+                if (!std::isfinite(d[x]))
+                    continue;
+                const Vec3d g = ground.toGround(cam.unproject(Point2d(x, y), d[x]));
+                for (int k = 0; k < 3; k++)
+                {
+                    minCorner[k] = std::min(minCorner[k], g[k]);
+                    maxCorner[k] = std::max(maxCorner[k], g[k]);
+                }
+                seen++;
+            }
+        }
+    }
+    if (!seen)
+        CV_Error(Error::StsObjectNotFound, "the clone of '" + object + "' is seen in no frame");
+}
+
+std::vector<Matx44d> scenePoses(const VirtualScene& scene, const Reconstruction& rec,
+                                const CloneSet* clones)
+{
+    std::vector<Matx44d> poses;
+    GroundFrame ground;
+    bool groundReady = false;
+    for (const SceneObject& o : scene.objects)
+    {
+        const Matx33d Rs = eulerDeg(o.rotationDeg) *
+                           Matx33d(o.scale[0], 0, 0, 0, o.scale[1], 0, 0, 0, o.scale[2]);
+        if (o.placement == SceneObject::PLACE_ABSOLUTE)
+        {
+            poses.push_back(affine(Rs, o.position));
+            continue;
+        }
+        const String where = scene.path + ": object '" + o.name + "'";
+        if (!clones)
+            CV_Error(Error::StsBadArg, where + " is placed relative to clone '" + o.anchor +
+                     "' but no clones are given");
+        const std::vector<String> names = clones->objectNames();
+        if (std::find(names.begin(), names.end(), o.anchor) == names.end())
+            CV_Error(Error::StsBadArg, where + ": no clone named '" + o.anchor + "'");
+        if (!groundReady)
+        {
+            ground = estimateGround(rec);
+            groundReady = true;
+        }
+        Vec3d cmin, cmax;
+        estimateCloneBounds(*clones, o.anchor, rec, ground, cmin, cmax);
+        const Vec3d cext = cmax - cmin;
+        const double cloneSize = std::max(cext[0], std::max(cext[1], cext[2]));
+        // Object bounds after rotation and scale (object coordinates, y up).
+        Vec3d omin = Vec3d::all(std::numeric_limits<double>::infinity()), omax = -omin;
+        for (const Mesh& m : o.meshes)
+            for (const Vec3f& v : m.vertices)
+            {
+                const Vec3d p = Rs * Vec3d(v);
+                for (int k = 0; k < 3; k++)
+                {
+                    omin[k] = std::min(omin[k], p[k]);
+                    omax[k] = std::max(omax[k], p[k]);
+                }
+            }
+        double k = 1.0;
+        if (o.size > 0)
+        {
+            const Vec3d oext = omax - omin;
+            const double osize = std::max(oext[0], std::max(oext[1], oext[2]));
+            k = o.size * cloneSize / std::max(osize, 1e-12);
+        }
+        omin *= k;
+        omax *= k;
+        // Ground coordinates of the object origin: base on the ground (y = 0).
+        const double gap = o.distance * cloneSize;
+        const Vec3d ccenter = 0.5 * (cmin + cmax);
+        Vec3d g(ccenter[0] - 0.5 * (omin[0] + omax[0]), -omin[1],
+                ccenter[2] - 0.5 * (omin[2] + omax[2]));
+        if (o.placement == SceneObject::PLACE_BEHIND)
+            g[2] = cmin[2] - gap - omax[2];  // back axis points to the viewer
+        else if (o.placement == SceneObject::PLACE_IN_FRONT)
+            g[2] = cmax[2] + gap - omin[2];
+        else if (o.side > 0)
+            g[0] = cmax[0] + gap - omin[0];
+        else
+            g[0] = cmin[0] - gap - omax[0];
+        g += o.offset * cloneSize;
+        // Object axes (x, y, z) -> ground axes (right, up, back), scaled by k.
+        const Matx33d B(ground.right[0], ground.up[0], ground.back[0],
+                        ground.right[1], ground.up[1], ground.back[1],
+                        ground.right[2], ground.up[2], ground.back[2]);
+        poses.push_back(affine(B * Rs * k, ground.fromGround(g)));
+    }
+    return poses;
+}
+
+std::vector<Mesh> placeScene(const VirtualScene& scene, const Reconstruction& rec,
+                             const CloneSet* clones)
+{
+    const std::vector<Matx44d> poses = scenePoses(scene, rec, clones);
+    std::vector<Mesh> out;
+    for (size_t i = 0; i < scene.objects.size(); i++)
+        for (const Mesh& m : scene.objects[i].meshes)
+        {
+            Mesh w = m;
+            w.transform(poses[i]);
+            out.push_back(std::move(w));
+        }
+    return out;
+}
+
+} // namespace augocc
+} // namespace cv

@@ -1,0 +1,305 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// End-to-end test of `augocc annotate`: the real window under a private Xvfb display, driven by
+// xdotool, checked by the mask it writes. Skips when Xvfb or xdotool is missing.
+// With AUGOCC_ANNOTATE_SHOTS=<dir> it also grabs screenshots of the window (ffmpeg x11grab) for
+// the documentation.
+
+#include "test_precomp.hpp"
+#include "test_silhouette_scene.hpp"
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+namespace fs = std::filesystem;
+
+// Same target as the headless test (issue 6: IoU >= 0.98 with <= 12 clicks).
+const double kMinE2eIoU = 0.98;
+// Generous limits: the window appears in ~1 s on an idle machine; 2 cores shared with builds.
+const double kStartTimeoutS = 40.0;
+const double kExitTimeoutS = 30.0;
+
+bool haveTool(const std::string& name)
+{
+    return runCommand("command -v " + name + " >/dev/null") == 0;
+}
+
+// A child process killed (TERM, then KILL) when the guard goes out of scope.
+struct Child
+{
+    pid_t pid = -1;
+    ~Child() { stop(); }
+    void stop()
+    {
+        if (pid <= 0)
+            return;
+        ::kill(pid, SIGTERM);
+        for (int i = 0; i < 50; ++i)
+        {
+            if (::waitpid(pid, nullptr, WNOHANG) == pid)
+            {
+                pid = -1;
+                return;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, nullptr, 0);
+        pid = -1;
+    }
+    // Exit status, or -1 on timeout or abnormal end.
+    int wait(double timeoutS)
+    {
+        const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeoutS);
+        while (std::chrono::steady_clock::now() < end)
+        {
+            int status = 0;
+            if (::waitpid(pid, &status, WNOHANG) == pid)
+            {
+                pid = -1;
+                return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        return -1;
+    }
+};
+
+// Starts argv with extra environment, stdout+stderr into logPath.
+pid_t spawn(const std::vector<std::string>& argv, const std::vector<std::string>& env,
+            const std::string& logPath)
+{
+    const pid_t pid = ::fork();
+    if (pid != 0)
+        return pid;
+    const int fd = ::open(logPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0)
+    {
+        ::dup2(fd, 1);
+        ::dup2(fd, 2);
+        ::close(fd);
+    }
+    for (const std::string& e : env)
+        ::putenv(::strdup(e.c_str()));
+    std::vector<char*> args;
+    for (const std::string& a : argv)
+        args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    ::execvp(args[0], args.data());
+    ::_exit(127);
+}
+
+// A display number nobody uses: from the pid, skipping numbers with a lock or socket.
+int freeDisplay()
+{
+    for (int i = 0; i < 400; ++i)
+    {
+        const int n = 100 + (int(::getpid()) + i) % 400;
+        if (!fs::exists(format("/tmp/.X%d-lock", n)) && !fs::exists(format("/tmp/.X11-unix/X%d", n)))
+            return n;
+    }
+    return -1;
+}
+
+std::string readFile(const std::string& path)
+{
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+void sleepMs(int ms)
+{
+    std::this_thread::sleep_for(std::chrono::milliseconds(ms));
+}
+
+class Xdo
+{
+public:
+    explicit Xdo(const std::string& display) : display_(display) {}
+    void run(const std::string& args)
+    {
+        std::string out;
+        const int rc = runCommand("DISPLAY=" + display_ + " timeout 10 xdotool " + args, &out);
+        EXPECT_EQ(0, rc) << "xdotool " << args << ": " << out;
+    }
+    // --sync waits for the pointer to move, so it is not used for the position it is at.
+    void moveTo(Point screen)
+    {
+        if (screen == pointer_)
+            return;
+        run(format("mousemove --sync %d %d", screen.x, screen.y));
+        pointer_ = screen;
+        sleepMs(60);
+    }
+    void click(Point screen)
+    {
+        moveTo(screen);
+        run("click 1");
+        sleepMs(250);  // one live-wire segment plus a redraw
+    }
+    void key(const std::string& k)
+    {
+        run("key " + k);
+        sleepMs(250);
+    }
+
+private:
+    std::string display_;
+    Point pointer_ = Point(-1, -1);
+};
+
+void grab(const std::string& display, const Rect& r, const std::string& path)
+{
+    std::string out;
+    const int rc = runCommand(format("timeout 20 ffmpeg -loglevel error -y -f x11grab "
+                                     "-video_size %dx%d -i %s+%d,%d -frames:v 1 '%s'",
+                                     r.width, r.height, display.c_str(), r.x, r.y, path.c_str()),
+                              &out);
+    EXPECT_EQ(0, rc) << "ffmpeg x11grab: " << out;
+}
+
+TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
+{
+    if (!haveTool("Xvfb") || !haveTool("xdotool"))
+        GTEST_SKIP() << "Xvfb or xdotool not installed (scripts/setup.sh installs xvfb xdotool)";
+    const std::string bin = augoccBinary();
+    if (!fs::exists(bin))
+        GTEST_SKIP() << "augocc binary not built: " << bin;
+    const char* shotsEnv = std::getenv("AUGOCC_ANNOTATE_SHOTS");
+    const std::string shots = shotsEnv ? shotsEnv : "";
+    if (!shots.empty() && !haveTool("ffmpeg"))
+        GTEST_SKIP() << "AUGOCC_ANNOTATE_SHOTS set but ffmpeg missing";
+
+    // Three frames of a box building seen from a slowly turning camera.
+    const std::string dir = tempDir("annotate");
+    fs::create_directories(dir + "/frames");
+    const Size size(640, 480);
+    std::vector<SilhouetteScene> scenes;
+    for (int f = 0; f < 3; ++f)
+    {
+        scenes.push_back(drawBoxScene(orbitCamera(30 + 2 * f, 25, size.height / 14.0, size),
+                                      size, 21));
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scenes.back().image));
+    }
+    const std::string masks = dir + "/masks";
+
+    const int dispNum = freeDisplay();
+    ASSERT_GE(dispNum, 0) << "no free X display number";
+    const std::string display = format(":%d", dispNum);
+    Child xvfb;
+    xvfb.pid = spawn({"Xvfb", display, "-screen", "0", "1024x768x24", "-nolisten", "tcp"}, {},
+                     dir + "/xvfb.log");
+    ASSERT_GT(xvfb.pid, 0);
+    const std::string socket = format("/tmp/.X11-unix/X%d", dispNum);
+    for (int i = 0; i < 200 && !fs::exists(socket); ++i)
+        sleepMs(50);
+    ASSERT_TRUE(fs::exists(socket)) << "Xvfb did not start: " << readFile(dir + "/xvfb.log");
+
+    Child tool;
+    const std::string log = dir + "/annotate.log";
+    tool.pid = spawn({bin, "annotate", "--input", dir + "/frames", "--masks", masks, "--object",
+                      "building", "--screenshot-dir", dir},
+                     {"DISPLAY=" + display, "QT_QPA_PLATFORM=xcb"}, log);
+    ASSERT_GT(tool.pid, 0);
+    Rect rect;
+    bool found = false;
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!found && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() <
+                         kStartTimeoutS)
+    {
+        const std::string text = readFile(log);
+        const size_t at = text.find("window image rect ");
+        if (at != std::string::npos && text.find('\n', at) != std::string::npos)
+        {
+            std::istringstream is(text.substr(at + 18));
+            is >> rect.x >> rect.y >> rect.width >> rect.height;
+            found = true;
+        }
+        else
+        {
+            int status;
+            ASSERT_NE(tool.pid, ::waitpid(tool.pid, &status, WNOHANG))
+                << "augocc annotate ended early:\n" << text;
+            sleepMs(100);
+        }
+    }
+    ASSERT_TRUE(found) << "no window within " << kStartTimeoutS << " s:\n" << readFile(log);
+    // The window shows the frame 1:1 at the top of its image area, status lines below it.
+    ASSERT_EQ(size.width, rect.width) << readFile(log);
+    ASSERT_GE(rect.height, size.height);
+    sleepMs(300);
+
+    // Trace: the building's corners, a couple of pixels off as a hand would be.
+    std::vector<std::vector<Point>> contours;
+    findContours(scenes[0].mask.clone(), contours, RETR_EXTERNAL, CHAIN_APPROX_NONE);
+    ASSERT_FALSE(contours.empty());
+    std::vector<Point> corners;
+    approxPolyDP(contours[0], corners, 2.0, true);
+    RNG rng(5);
+    std::vector<Point> clicks;
+    for (const Point& c : corners)
+        clicks.push_back(c + Point(rng.uniform(-2, 3), rng.uniform(-2, 3)));
+    Xdo xdo(display);
+    const Point origin = rect.tl();
+    for (size_t i = 0; i < clicks.size(); ++i)
+    {
+        if (!shots.empty() && i + 1 == clicks.size())
+        {
+            // Before the last click: hover there so that the live-wire preview shows.
+            xdo.moveTo(origin + clicks[i]);
+            sleepMs(600);
+            grab(display, rect, shots + "/annotate_tracing.png");
+        }
+        xdo.click(origin + clicks[i]);
+    }
+    xdo.click(origin + clicks[0]);  // on the first anchor: closes the contour
+    int clickCount = int(clicks.size()) + 1;
+    EXPECT_LE(clickCount, 12);
+    if (!shots.empty())
+    {
+        xdo.moveTo(origin + Point(20, size.height - 20));
+        sleepMs(400);
+        grab(display, rect, shots + "/annotate_closed.png");
+        xdo.key("h");
+        sleepMs(300);
+        grab(display, rect, shots + "/annotate_help.png");
+        xdo.key("h");
+    }
+    xdo.key("w");       // the tool's own screenshot of its canvas
+    xdo.key("n");       // next frame: the traced frame is committed
+    xdo.key("q");       // save and quit
+    const int rc = tool.wait(kExitTimeoutS);
+    const std::string text = readFile(log);
+    ASSERT_EQ(0, rc) << "augocc annotate did not exit cleanly:\n" << text;
+    xvfb.stop();
+
+    const Mat written = imread(masks + "/building/0000.png", IMREAD_GRAYSCALE);
+    ASSERT_FALSE(written.empty()) << "no mask written:\n" << text;
+    EXPECT_EQ(size, written.size());
+    const double iou = maskIoU(written, scenes[0].mask);
+    std::cout << format("[ annotate e2e ] %d clicks, IoU %.4f", clickCount, iou) << std::endl;
+    EXPECT_GE(iou, kMinE2eIoU);
+    EXPECT_FALSE(fs::exists(masks + "/building/0001.png")) << "frame 1 was not traced";
+    bool shot = false;
+    for (const auto& e : fs::directory_iterator(dir))
+        shot = shot || e.path().filename().string().rfind("annotate_building_0000", 0) == 0;
+    EXPECT_TRUE(shot) << "the w key saved no screenshot:\n" << text;
+    fs::remove_all(dir);
+}
+
+} // namespace
+} // namespace opencv_test

@@ -1,0 +1,317 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#include "test_precomp.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/videoio.hpp>
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+namespace fs = std::filesystem;
+
+const float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+Tracks makeTracks(int frames, int points)
+{
+    Tracks t;
+    t.imageSize = Size(640, 480);
+    t.tracks.create(frames, points, CV_32FC2);
+    RNG rng(3);
+    for (int f = 0; f < frames; f++)
+        for (int p = 0; p < points; p++)
+            t.tracks.at<Point2f>(f, p) = ((p % 3 == 0) && (f > p % frames))
+                                             ? Point2f(kNaN, kNaN)
+                                             : Point2f(rng.uniform(0.f, 640.f),
+                                                       rng.uniform(0.f, 480.f));
+    return t;
+}
+
+Reconstruction makeReconstruction(CameraModel model)
+{
+    Reconstruction r;
+    r.model = model;
+    r.imageSize = Size(640, 480);
+    for (int f = 0; f < 4; f++)
+    {
+        const Matx33d R = rotationFromRodrigues(Vec3d(0.1 * f, 0.2, -0.05 * f));
+        if (model == SCALED_ORTHOGRAPHIC)
+            r.cameras.push_back(Camera::orthographic(R, Vec3d(0.1 * f, 0.2, 30), 20.0 + f,
+                                                     Point2d(320, 240), 2 * f));
+        else
+            r.cameras.push_back(Camera::perspective(R, Vec3d(0.1 * f, 0.2, 30),
+                                                    Matx33d(700, 0, 320, 0, 700, 240, 0, 0, 1),
+                                                    2 * f));
+    }
+    r.points = (Mat_<double>(3, 3) << 1, 2, 3, NAN, NAN, NAN, -1.5, 0.25, 7);
+    return r;
+}
+
+// Writes `text` to a file and returns its path.
+std::string writeText(const std::string& dir, const std::string& name, const std::string& text)
+{
+    const std::string p = dir + "/" + name;
+    std::ofstream(p) << text;
+    return p;
+}
+
+// Expects fn to throw a cv::Exception whose message contains every fragment.
+template <typename Fn>
+void expectErrorMentions(Fn fn, std::initializer_list<std::string> fragments)
+{
+    try
+    {
+        fn();
+        ADD_FAILURE() << "no exception";
+    }
+    catch (const cv::Exception& e)
+    {
+        for (const std::string& f : fragments)
+            EXPECT_NE(e.err.find(f), std::string::npos) << "'" << f << "' not in: " << e.err;
+    }
+}
+
+TEST(Augocc_Tracks, regression_round_trip)
+{
+    const std::string dir = tempDir("io");
+    const Tracks t = makeTracks(7, 11);
+    for (const char* name : {"tracks.yml", "tracks.yml.gz", "tracks.json"})
+    {
+        const std::string p = dir + "/" + name;
+        writeTracks(p, t);
+        const Tracks r = readTracks(p);
+        EXPECT_EQ(r.imageSize, t.imageSize);
+        ASSERT_EQ(r.tracks.size(), t.tracks.size());
+        ASSERT_EQ(r.tracks.type(), CV_32FC2);
+        for (int f = 0; f < t.frames(); f++)
+            for (int p2 = 0; p2 < t.points(); p2++)
+            {
+                EXPECT_EQ(r.observed(f, p2), t.observed(f, p2));
+                if (t.observed(f, p2))
+                {
+                    EXPECT_EQ(r.at(f, p2), t.at(f, p2)); // float -> text -> float is exact
+                }
+            }
+    }
+    // No temporary file left behind.
+    int files = 0;
+    for (const auto& e : fs::directory_iterator(dir))
+        files += e.path().filename().string()[0] == '.' ? 100 : 1;
+    EXPECT_EQ(files, 3);
+}
+
+TEST(Augocc_Tracks, bad_arg)
+{
+    const std::string dir = tempDir("io");
+    expectErrorMentions([&] { readTracks(dir + "/missing.yml"); }, {"missing.yml", "not found"});
+    const std::string garbage = writeText(dir, "garbage.yml", "%YAML:1.0\n: : [\n");
+    expectErrorMentions([&] { readTracks(garbage); }, {"garbage.yml"});
+    const std::string head = "%YAML:1.0\n---\n";
+    const std::string noSize = writeText(dir, "nosize.yml", head + "frames: 1\npoints: 1\n");
+    expectErrorMentions([&] { readTracks(noSize); }, {"nosize.yml", "image_size"});
+    const std::string mat1x1 = "tracks: !!opencv-matrix\n   rows: 1\n   cols: 1\n   dt: \"2f\"\n"
+                               "   data: [ 1., 2. ]\n";
+    const std::string sz = "image_size: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: i\n"
+                           "   data: [ 640, 480 ]\n";
+    const std::string noFrames = writeText(dir, "noframes.yml", head + sz + "points: 1\n" + mat1x1);
+    expectErrorMentions([&] { readTracks(noFrames); }, {"noframes.yml", "frames"});
+    const std::string mismatch = writeText(dir, "mismatch.yml", head + sz + "frames: 2\n"
+                                           "points: 1\n" + mat1x1);
+    expectErrorMentions([&] { readTracks(mismatch); }, {"mismatch.yml", "frames = 2"});
+    const std::string wrongType = writeText(dir, "type.yml", head + sz + "frames: 1\npoints: 1\n"
+        "tracks: !!opencv-matrix\n   rows: 1\n   cols: 1\n   dt: i\n   data: [ 1 ]\n");
+    expectErrorMentions([&] { readTracks(wrongType); }, {"type.yml", "tracks"});
+    const std::string badSize = writeText(dir, "badsize.yml", head +
+        "image_size: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: i\n   data: [ 0, 480 ]\n"
+        "frames: 1\npoints: 1\n" + mat1x1);
+    expectErrorMentions([&] { readTracks(badSize); }, {"badsize.yml", "image_size"});
+    const std::string halfNaN = writeText(dir, "halfnan.yml", head + sz + "frames: 1\npoints: 1\n"
+        "tracks: !!opencv-matrix\n   rows: 1\n   cols: 1\n   dt: \"2f\"\n   data: [ 1., .Nan ]\n");
+    expectErrorMentions([&] { readTracks(halfNaN); }, {"halfnan.yml", "NaN"});
+}
+
+class Augocc_Reconstruction_P : public testing::TestWithParam<int> {};
+
+TEST_P(Augocc_Reconstruction_P, regression_round_trip)
+{
+    const std::string dir = tempDir("io");
+    const Reconstruction rec = makeReconstruction((CameraModel)GetParam());
+    const std::string p = dir + "/reconstruction.yml";
+    writeReconstruction(p, rec);
+    const Reconstruction r = readReconstruction(p);
+    EXPECT_EQ(r.model, rec.model);
+    EXPECT_EQ(r.imageSize, rec.imageSize);
+    ASSERT_EQ(r.cameras.size(), rec.cameras.size());
+    for (size_t i = 0; i < rec.cameras.size(); i++)
+    {
+        EXPECT_EQ(r.cameras[i].frame, rec.cameras[i].frame);
+        // FileStorage writes doubles with 16 significant digits.
+        const double kTextEps = 1e-12;
+        EXPECT_MAT_NEAR(Mat(r.cameras[i].R), Mat(rec.cameras[i].R), kTextEps);
+        EXPECT_MAT_NEAR(Mat(r.cameras[i].t), Mat(rec.cameras[i].t), kTextEps);
+        const Vec3d X(0.3, -0.7, 1.1);
+        EXPECT_LT(cv::norm(r.cameras[i].project(X) - rec.cameras[i].project(X)), 1e-9);
+    }
+    ASSERT_EQ(r.points.size(), rec.points.size());
+    EXPECT_EQ(r.validPointCount(), 2);
+    EXPECT_TRUE(std::isnan(r.points.at<double>(1, 0)));
+    EXPECT_EQ(r.findCamera(4), 2);
+    EXPECT_EQ(r.findCamera(5), -1);
+    EXPECT_THROW(r.camera(5), cv::Exception);
+}
+
+INSTANTIATE_TEST_SUITE_P(/**/, Augocc_Reconstruction_P,
+                         testing::Values((int)SCALED_ORTHOGRAPHIC, (int)PERSPECTIVE));
+
+TEST(Augocc_Reconstruction, bad_arg)
+{
+    const std::string dir = tempDir("io");
+    const std::string good = dir + "/good.yml";
+    writeReconstruction(good, makeReconstruction(SCALED_ORTHOGRAPHIC));
+    std::string text;
+    {
+        std::ifstream in(good);
+        text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
+        std::string t = text;
+        const size_t pos = t.find(from);
+        EXPECT_NE(pos, std::string::npos) << from;
+        if (pos != std::string::npos)
+            t.replace(pos, from.size(), to);
+        return writeText(dir, name, t);
+    };
+    // Missing key.
+    const std::string noModel = variant("nomodel.yml", "model:", "modelx:");
+    expectErrorMentions([&] { readReconstruction(noModel); }, {"nomodel.yml", "'model'"});
+    const std::string badModel = variant("badmodel.yml", "scaled_orthographic", "fisheye");
+    expectErrorMentions([&] { readReconstruction(badModel); }, {"badmodel.yml", "fisheye"});
+    const std::string noS = variant("nos.yml", "      s:", "      q:");
+    expectErrorMentions([&] { readReconstruction(noS); }, {"nos.yml", "cameras[0]", "'s'"});
+    // Non-positive scale.
+    const std::string zeroS = variant("zeros.yml", "      s: 20.", "      s: -20.");
+    expectErrorMentions([&] { readReconstruction(zeroS); }, {"zeros.yml", "scale"});
+    // R not a rotation.
+    const std::string notRot = variant("notrot.yml", "data: [ 9.8006657784124163e-01", "data: [ 1.5");
+    expectErrorMentions([&] { readReconstruction(notRot); }, {"notrot.yml", "not a rotation"});
+    // Wrong matrix shape.
+    const std::string shape = variant("shape.yml", "rows: 3\n         cols: 1", "rows: 1\n         cols: 3");
+    expectErrorMentions([&] { readReconstruction(shape); }, {"shape.yml", "'t'", "3x1"});
+    // Points of the wrong width.
+    const std::string pts = variant("pts.yml", "points: !!opencv-matrix\n   rows: 3\n   cols: 3",
+                                    "points: !!opencv-matrix\n   rows: 9\n   cols: 1");
+    expectErrorMentions([&] { readReconstruction(pts); }, {"pts.yml", "points"});
+    // Frames out of order.
+    Reconstruction r = makeReconstruction(SCALED_ORTHOGRAPHIC);
+    std::swap(r.cameras[0], r.cameras[1]);
+    expectErrorMentions([&] { writeReconstruction(dir + "/order.yml", r); }, {"frame"});
+    EXPECT_FALSE(fs::exists(dir + "/order.yml"));
+}
+
+TEST(Augocc_Masks, regression_round_trip)
+{
+    const std::string dir = tempDir("io") + "/masks";
+    ObjectMasks masks;
+    Mat a = Mat::zeros(48, 64, CV_8U), b = Mat::zeros(48, 64, CV_8U);
+    cv::rectangle(a, Rect(5, 6, 20, 10), Scalar(255), FILLED);
+    cv::circle(b, Point(40, 30), 9, Scalar(255), FILLED);
+    masks["front"][0] = a;
+    masks["front"][12] = b;
+    masks["tower"][3] = b;
+    writeMasks(dir, masks);
+    EXPECT_TRUE(fs::exists(dir + "/front/0012.png"));
+    const ObjectMasks r = readMasks(dir, Size(64, 48));
+    ASSERT_EQ(r.size(), 2u);
+    ASSERT_EQ(r.at("front").size(), 2u);
+    EXPECT_MAT_NEAR(r.at("front").at(12), b, 0);
+    EXPECT_MAT_NEAR(r.at("tower").at(3), b, 0);
+    // Writing again replaces the folder, leaving no stale frames.
+    masks.erase("tower");
+    writeMasks(dir, masks);
+    EXPECT_EQ(readMasks(dir).size(), 1u);
+}
+
+TEST(Augocc_Masks, bad_arg)
+{
+    const std::string dir = tempDir("io");
+    expectErrorMentions([&] { readMasks(dir + "/none"); }, {"none", "not found"});
+    fs::create_directories(dir + "/m/obj");
+    expectErrorMentions([&] { readMasks(dir + "/m"); }, {"no <object>"});
+    cv::imwrite(dir + "/m/obj/0001.png", Mat::zeros(10, 12, CV_8U));
+    expectErrorMentions([&] { readMasks(dir + "/m", Size(64, 48)); },
+                        {"0001.png", "12x10", "64x48"});
+    writeText(dir + "/m/obj", "0002.png", "not a png");
+    expectErrorMentions([&] { readMasks(dir + "/m"); }, {"0002.png", "cannot read"});
+    fs::remove(dir + "/m/obj/0002.png");
+    cv::imwrite(dir + "/m/obj/frame.png", Mat::zeros(10, 12, CV_8U));
+    expectErrorMentions([&] { readMasks(dir + "/m"); }, {"frame.png", "frame index"});
+}
+
+TEST(Augocc_FrameSource, accuracy)
+{
+    const std::string dir = tempDir("io");
+    fs::create_directories(dir + "/frames");
+    for (int i = 0; i < 5; i++)
+        cv::imwrite(cv::format("%s/frames/%04d.png", dir.c_str(), i),
+                    Mat(24, 32, CV_8UC3, Scalar(10 * i, 20, 30)));
+    for (const std::string& input : {dir + "/frames", dir + "/frames/%04d.png"})
+    {
+        Ptr<FrameSource> src = FrameSource::open(input);
+        EXPECT_EQ(src->count(), 5);
+        EXPECT_EQ(src->size(), Size(32, 24));
+        Mat f;
+        int n = 0;
+        while (src->read(f))
+        {
+            EXPECT_EQ(f.at<Vec3b>(0, 0)[0], 10 * n);
+            n++;
+        }
+        EXPECT_EQ(n, 5);
+        src->seek(3);
+        ASSERT_TRUE(src->read(f));
+        EXPECT_EQ(f.at<Vec3b>(0, 0)[0], 30);
+    }
+    // A video written with OpenCV reads back frame for frame.
+    const std::string video = dir + "/v.avi";
+    {
+        VideoWriter w(video, VideoWriter::fourcc('M', 'J', 'P', 'G'), 25, Size(32, 24));
+        ASSERT_TRUE(w.isOpened());
+        for (int i = 0; i < 6; i++)
+            w.write(Mat(24, 32, CV_8UC3, Scalar(40 * i, 40 * i, 40 * i)));
+    }
+    Ptr<FrameSource> v = FrameSource::open(video);
+    EXPECT_EQ(v->size(), Size(32, 24));
+    Mat f;
+    int n = 0;
+    while (v->read(f))
+        n++;
+    EXPECT_EQ(n, 6);
+    v->seek(2);
+    ASSERT_TRUE(v->read(f));
+    const int kJpegTol = 8; // MJPG is lossy
+    EXPECT_NEAR(f.at<Vec3b>(12, 16)[1], 80, kJpegTol);
+}
+
+TEST(Augocc_FrameSource, bad_arg)
+{
+    const std::string dir = tempDir("io");
+    expectErrorMentions([&] { FrameSource::open(dir + "/nothing.mp4"); }, {"nothing.mp4"});
+    const std::string corrupt = writeText(dir, "corrupt.mp4", std::string(4096, 'x'));
+    expectErrorMentions([&] { FrameSource::open(corrupt); }, {"corrupt.mp4"});
+    fs::create_directories(dir + "/empty");
+    expectErrorMentions([&] { FrameSource::open(dir + "/empty"); }, {"empty", "no image"});
+    expectErrorMentions([&] { FrameSource::open(dir + "/x/%04d.png"); }, {"pattern"});
+    fs::create_directories(dir + "/mixed");
+    cv::imwrite(dir + "/mixed/0000.png", Mat(24, 32, CV_8UC3, Scalar::all(0)));
+    cv::imwrite(dir + "/mixed/0001.png", Mat(20, 32, CV_8UC3, Scalar::all(0)));
+    Ptr<FrameSource> src = FrameSource::open(dir + "/mixed");
+    Mat f;
+    EXPECT_TRUE(src->read(f));
+    expectErrorMentions([&] { src->read(f); }, {"0001.png", "32x20"});
+}
+
+} // namespace
+} // namespace opencv_test
