@@ -223,6 +223,19 @@ public:
             d.copyTo(depth);
     }
     void save(const String&) const CV_OVERRIDE {}
+    // The rest of the CloneSet interface is not used by the compositor.
+    std::vector<int> keyFrames(const String&) const CV_OVERRIDE { return {}; }
+    std::vector<int> patchFrames(const String&, int) const CV_OVERRIDE { return {}; }
+    int voxelCount(const String&) const CV_OVERRIDE { return 0; }
+    int patchVoxelCount(const String&, int) const CV_OVERRIDE { return 0; }
+    Vec3i gridSize(const String&) const CV_OVERRIDE { return Vec3i(); }
+    double voxelSize(const String&) const CV_OVERRIDE { return 0; }
+    void gridPose(const String&, Matx33d& R, Vec3d& o) const CV_OVERRIDE
+    {
+        R = Matx33d::eye();
+        o = Vec3d();
+    }
+    void exportPly(const String&) const CV_OVERRIDE {}
 };
 
 // The CloneSet overload renders the clones at the supersampled grid: the same result as the
