@@ -77,6 +77,18 @@ TEST_P(Augocc_VoxelGrid_P, carve_equals_brute_force)
 INSTANTIATE_TEST_SUITE_P(/**/, Augocc_VoxelGrid_P, testing::Values((int)SCALED_ORTHOGRAPHIC,
                                                                     (int)PERSPECTIVE));
 
+TEST(Augocc_VoxelGrid, label_distance_matches_opencv)
+{
+    RNG rng(5);
+    const Mat m = blobMask(Size(200, 150), rng);
+    Mat dk, dc;
+    distanceTransform(m, dk, DIST_C, 3);
+    distanceTransform(m == 0, dc, DIST_C, 3);
+    Mat ref = dk + dc, mine;
+    labelDistance(m).convertTo(mine, CV_32F);
+    EXPECT_MAT_NEAR(mine, ref, 0.0);
+}
+
 TEST(Augocc_VoxelGrid, runs_roundtrip_and_surface)
 {
     VoxelGrid g;

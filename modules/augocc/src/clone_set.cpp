@@ -330,15 +330,23 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
         CV_Error(Error::StsBadSize, cv::format("clones: render: bad image size %dx%d",
                                                imageSize.width, imageSize.height));
     const VoxelProjector proj = o.grid.projector(camera, imageSize);
-    Mat zmin(imageSize, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
-    splatVoxels(proj, o.surface.ijk.data(), o.surface.faces.data(), o.surface.size(), true, zmin,
-                nullptr);
+    std::vector<VoxelList> lists(1);
+    lists[0].ijk = o.surface.ijk.data();
+    lists[0].faces = o.surface.faces.data();
+    lists[0].n = o.surface.size();
+    lists[0].frontOnly = true;
     for (int kf : patchFrames(object, frame))
     {
         auto it = o.patches.find(kf);
-        if (it != o.patches.end())
-            splatVoxels(proj, it->second.data(), nullptr, it->second.size(), false, zmin, nullptr);
+        if (it == o.patches.end() || it->second.empty())
+            continue;
+        VoxelList l;
+        l.ijk = it->second.data();
+        l.n = it->second.size();
+        lists.push_back(l);
     }
+    Mat zmin;
+    renderDepth(o.grid, proj, lists, zmin);
     if (matte.needed())
     {
         Mat m = zmin < std::numeric_limits<float>::infinity();
