@@ -381,50 +381,6 @@ SurfaceVoxels VoxelGrid::surface() const
     return out;
 }
 
-Mat VoxelGrid::encodeRuns() const
-{
-    // Voxels are 0 or 1: memchr finds each run's end (vectorised in libc).
-    std::vector<int> runs;
-    const uchar* p = data.data();
-    const uchar* end = p + data.size();
-    int cur = 0;
-    while (p < end)
-    {
-        const uchar* q = (const uchar*)std::memchr(p, cur ^ 1, (size_t)(end - p));
-        if (!q)
-            q = end;
-        runs.push_back((int)(q - p));
-        p = q;
-        cur ^= 1;
-    }
-    if (runs.empty())
-        runs.push_back(0);
-    return Mat(runs, true);
-}
-
-void VoxelGrid::decodeRuns(const Mat& runs, const String& what)
-{
-    if (runs.type() != CV_32SC1 || (runs.cols != 1 && runs.rows != 1))
-        CV_Error(Error::StsParseError, what + ": voxel runs must be a CV_32S vector");
-    const int64 n = total();
-    data.assign((size_t)n, 0);
-    const int* r = runs.ptr<int>();
-    const size_t m = runs.total();
-    int64 pos = 0;
-    uchar cur = 0;
-    for (size_t q = 0; q < m; q++, cur ^= 1)
-    {
-        if (r[q] < 0 || pos + r[q] > n)
-            CV_Error(Error::StsParseError, what + ": voxel runs overflow the grid");
-        if (cur)
-            std::memset(&data[(size_t)pos], 1, (size_t)r[q]);
-        pos += r[q];
-    }
-    if (pos != n)
-        CV_Error(Error::StsParseError, what + cv::format(": voxel runs cover %lld voxels, the "
-                 "grid has %lld", (long long)pos, (long long)n));
-}
-
 namespace {
 
 // Corner offsets (in voxel units from the centre) of face f (-x,+x,-y,+y,-z,+z), counter-clockwise

@@ -12,7 +12,7 @@
 
 /*
 The one voxel grid of the module (DESIGN.md): dense, one byte per voxel, a rigid box pose, carving
-against silhouettes, surface extraction, footprint splatting (matte + depth) and run-length I/O.
+against silhouettes, surface extraction and footprint splatting (matte + depth). File encoding: clone_codec.hpp.
 
 Voxel (i, j, k) is the cube of edge h centred at origin + Rbox * (h * (i + 0.5, j + 0.5, k + 0.5)).
 Its FOOTPRINT in an image is the set of pixel centres inside the bounding rectangle of its
@@ -162,11 +162,6 @@ public:
 
     //! Voxels inside with at least one face on a voxel outside (or on the grid's border).
     SurfaceVoxels surface() const;
-
-    //! Run lengths of the flattened grid, alternating 0-runs and 1-runs, starting with 0 (CV_32S).
-    Mat encodeRuns() const;
-    //! Inverse of encodeRuns(); `dims` must be set. Throws StsParseError on inconsistent runs.
-    void decodeRuns(const Mat& runs, const String& what);
 
     //! Exposed faces of the surface as a mesh in world coordinates (two triangles per face).
     Mesh surfaceMesh(const SurfaceVoxels& s) const;
