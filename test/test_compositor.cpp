@@ -3,7 +3,7 @@
 
 #include "test_precomp.hpp"
 #include "gl_context.hpp"
-#include "compositor_shading.hpp"
+#include "shading.hpp"
 
 #include <opencv2/highgui.hpp>
 
@@ -63,10 +63,11 @@ Mat makeFrame()
 // The lit colour of the quad per the shading convention, BGR 8-bit.
 Vec3b expectedBgr(const Vec3f& diffuse, const Vec3f& ambient)
 {
-    Material m;
-    m.diffuse = diffuse;
-    m.ambient = ambient;
-    const Vec3f rgb = augocc::detail::shadeColor(m, lightDirection());
+    // base * (ambient + diffuse * max(0, n.L)) with n = L, base white.
+    const float ndotl = lightDirection().dot(lightDirection());
+    Vec3f rgb;
+    for (int k = 0; k < 3; k++)
+        rgb[k] = std::min(1.f, ambient[k] + diffuse[k] * ndotl);
     Vec3b c;
     for (int k = 0; k < 3; k++)
         c[2 - k] = saturate_cast<uchar>(255 * rgb[k]);
