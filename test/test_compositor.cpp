@@ -224,6 +224,18 @@ public:
             d.copyTo(depth);
     }
     void save(const String&) const CV_OVERRIDE {}
+    std::vector<int> keyFrames(const String&) const CV_OVERRIDE { return {}; }
+    std::vector<int> patchFrames(const String&, int) const CV_OVERRIDE { return {}; }
+    int voxelCount(const String&) const CV_OVERRIDE { return 0; }
+    int patchVoxelCount(const String&, int) const CV_OVERRIDE { return 0; }
+    Vec3i gridSize(const String&) const CV_OVERRIDE { return Vec3i(0, 0, 0); }
+    double voxelSize(const String&) const CV_OVERRIDE { return 1.0; }
+    void gridPose(const String&, Matx33d& R, Vec3d& origin) const CV_OVERRIDE
+    {
+        R = Matx33d::eye();
+        origin = Vec3d(0, 0, 0);
+    }
+    void exportPly(const String&) const CV_OVERRIDE {}
 };
 
 // The CloneSet overload renders the clones at the supersampled grid: the same result as the
