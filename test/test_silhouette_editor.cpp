@@ -4,6 +4,8 @@
 #include "test_precomp.hpp"
 #include "test_silhouette_scene.hpp"
 
+#include <filesystem>
+
 namespace opencv_test {
 namespace {
 using namespace cv;
@@ -298,6 +300,85 @@ TEST(Augocc_SilhouetteEditor, overlay_draws)
     Mat canvas = scene.image.clone();
     ed->drawOverlay(canvas, Point(50, 50));
     EXPECT_GT(norm(canvas, scene.image, NORM_L1), 0.0);
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+
+TEST(Augocc_SilhouetteEditor, resolve_visible_silhouettes)
+{
+    // Object 0 (near, z = 5) covers the left part of object 1 (far, z = 9).
+    std::vector<Mat> mattes(2), depths(2), visible;
+    for (int i = 0; i < 2; ++i)
+    {
+        mattes[i] = Mat::zeros(60, 80, CV_8U);
+        depths[i] = Mat(60, 80, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
+    }
+    rectangle(mattes[0], Rect(10, 10, 30, 30), Scalar::all(255), FILLED);
+    depths[0].setTo(5.f, mattes[0]);
+    rectangle(mattes[1], Rect(25, 5, 40, 40), Scalar::all(255), FILLED);
+    depths[1].setTo(9.f, mattes[1]);
+    resolveVisibleSilhouettes(mattes, depths, visible);
+    ASSERT_EQ(2u, visible.size());
+    EXPECT_EQ(0, norm(visible[0], mattes[0], NORM_INF));  // nothing in front of it
+    Mat expected1 = mattes[1].clone();
+    expected1.setTo(0, mattes[0]);
+    EXPECT_EQ(0, norm(visible[1], expected1, NORM_INF));
+    depths.pop_back();
+    EXPECT_THROW(resolveVisibleSilhouettes(mattes, depths, visible), cv::Exception);
+}
+
+// `augocc propagate --mattes`: coarse mattes in, snapped masks out, for the frames asked.
+TEST(Augocc_PropagateCli, mattes_snapped_and_bad_input)
+{
+    const std::string dir = tempDir("propagate");
+    std::filesystem::create_directories(dir + "/frames");
+    std::filesystem::create_directories(dir + "/mattes/building");
+    const Size size(640, 480);
+    std::vector<SilhouetteScene> scenes;
+    const Mat k = getStructuringElement(MORPH_ELLIPSE, Size(5, 5));  // 2 px radius
+    for (int f = 0; f < 3; ++f)
+    {
+        scenes.push_back(drawBoxScene(orbitCamera(30 + 3 * f, 25, size.height / 14.0, size),
+                                      size, 31 + f));
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scenes[f].image));
+        Mat coarse;
+        dilate(scenes[f].mask, coarse, k);
+        ASSERT_TRUE(imwrite(format("%s/mattes/building/%04d.png", dir.c_str(), f), coarse));
+    }
+    const std::string bin = augoccBinary();
+    std::string out;
+    const std::string base = bin + " propagate --input " + dir + "/frames";
+    ASSERT_EQ(0, runCommand(base + " --mattes " + dir + "/mattes --frames 0,2 --out " + dir +
+                            "/proposed", &out)) << out;
+    for (int f : {0, 2})
+    {
+        const Mat m = imread(format("%s/proposed/building/%04d.png", dir.c_str(), f),
+                             IMREAD_GRAYSCALE);
+        ASSERT_FALSE(m.empty()) << out;
+        const double kMinProposalIoU = 0.97;  // issue 6 target for proposed silhouettes
+        EXPECT_GE(maskIoU(m, scenes[f].mask), kMinProposalIoU) << "frame " << f;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir + "/proposed/building/0001.png"));
+    // Bad input: exit 2, a message naming the flag, no output.
+    const std::string o2 = " --out " + dir + "/bad";
+    EXPECT_EQ(2, runCommand(base + " --mattes " + dir + "/mattes --frames 0,7" + o2, &out));
+    EXPECT_NE(std::string::npos, out.find("--frames")) << out;
+    EXPECT_EQ(2, runCommand(base + " --mattes " + dir + "/mattes --frames 2:1" + o2, &out));
+    EXPECT_EQ(2, runCommand(base + " --mattes " + dir + "/mattes --frames x" + o2, &out));
+    EXPECT_EQ(2, runCommand(base + o2, &out));  // neither --clones nor --mattes
+    EXPECT_NE(std::string::npos, out.find("--mattes")) << out;
+    EXPECT_EQ(2, runCommand(base + " --mattes " + dir + "/nope" + o2, &out));
+    EXPECT_EQ(2, runCommand(base + " --clones " + dir + "/c.yml.gz" + o2, &out));
+    EXPECT_EQ(2, runCommand(bin + " propagate --input " + dir + "/none --mattes " + dir +
+                            "/mattes" + o2, &out));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/bad"));
+    std::filesystem::remove_all(dir);
 }
 
 } // namespace

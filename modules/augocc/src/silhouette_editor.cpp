@@ -835,5 +835,72 @@ void snapMaskToEdges(InputArray image, InputArray proposed, OutputArray snapped,
     editor->snapMask(proposed, snapped);
 }
 
+void resolveVisibleSilhouettes(const std::vector<Mat>& mattes, const std::vector<Mat>& depths,
+                               std::vector<Mat>& visible)
+{
+    if (mattes.size() != depths.size())
+        CV_Error(Error::StsBadSize, format("resolveVisibleSilhouettes: %d mattes but %d depth "
+                                           "maps", int(mattes.size()), int(depths.size())));
+    const size_t n = mattes.size();
+    visible.assign(n, Mat());
+    if (n == 0)
+        return;
+    const Size size = mattes[0].size();
+    for (size_t i = 0; i < n; ++i)
+    {
+        CV_CheckTypeEQ(mattes[i].type(), CV_8UC1, "resolveVisibleSilhouettes: mattes");
+        CV_CheckTypeEQ(depths[i].type(), CV_32FC1, "resolveVisibleSilhouettes: depths");
+        if (mattes[i].size() != size || depths[i].size() != size)
+            CV_Error(Error::StsBadSize, format("resolveVisibleSilhouettes: object %d has a "
+                                               "matte or depth map of another size", int(i)));
+    }
+    // Nearest depth over all objects' mattes, then each object keeps the pixels where it is the
+    // nearest (ties: visible for both).
+    Mat nearest(size, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
+    for (size_t i = 0; i < n; ++i)
+    {
+        Mat in = mattes[i] > 127;
+        Mat d = Mat(size, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
+        depths[i].copyTo(d, in);
+        min(nearest, d, nearest);
+    }
+    for (size_t i = 0; i < n; ++i)
+    {
+        Mat in = mattes[i] > 127;
+        Mat front = depths[i] <= nearest;
+        visible[i] = in & front;
+    }
+}
+
+void proposeSilhouettes(const CloneSet& clones, int frame, const Camera& camera,
+                        InputArray _image, std::map<String, Mat>& proposals, bool snap,
+                        const SilhouetteEditor::Params& params)
+{
+    Mat image = _image.getMat();
+    if (image.empty())
+        CV_Error(Error::StsBadArg, format("proposeSilhouettes: empty image for frame %d", frame));
+    const std::vector<String> names = clones.objectNames();
+    std::vector<Mat> mattes(names.size()), depths(names.size()), visible;
+    for (size_t i = 0; i < names.size(); ++i)
+        clones.render(names[i], frame, camera, image.size(), mattes[i], depths[i]);
+    resolveVisibleSilhouettes(mattes, depths, visible);
+    proposals.clear();
+    Ptr<SilhouetteEditor> editor;
+    if (snap)
+    {
+        editor = SilhouetteEditor::create(params);
+        editor->setImage(image);
+    }
+    for (size_t i = 0; i < names.size(); ++i)
+    {
+        Mat out;
+        if (snap && countNonZero(visible[i]) > 0)
+            editor->snapMask(visible[i], out);
+        else
+            out = visible[i];
+        proposals[names[i]] = out;
+    }
+}
+
 } // namespace augocc
 } // namespace cv
