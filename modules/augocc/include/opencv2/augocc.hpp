@@ -24,5 +24,6 @@ the real objects, and compositing by depth test.
 #include "opencv2/augocc/scene.hpp"
 #include "opencv2/augocc/silhouette_editor.hpp"
 #include "opencv2/augocc/key_frames.hpp"
+#include "opencv2/augocc/visualization.hpp"
 
 #endif

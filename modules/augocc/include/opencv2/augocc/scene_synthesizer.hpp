@@ -20,6 +20,28 @@ namespace augocc {
 
 World frame: y is up, the ground is the plane y = 0, objects stand on it near the origin; scene
 size (the diameter of the objects' footprint) about 10 world units.
+
+Tracks (columns p of `tracks`, `cleanTracks`, rows of `groundTruth.points`):
+- Inlier tracks are 3D points sampled on the surfaces of the objects (about 60%) and of the ground
+  that are visible (front-facing and not hidden) in the middle frame, and that project inside
+  every frame with a 2 px margin. A full track is observed in EVERY frame, even where another
+  object hides its point in that frame: occlusion is ignored on purpose, so that the full
+  measurement matrix of the factorization is available (tests of the paper's method need it).
+- `cleanTracks` are the exact projections through the true cameras; `tracks` add independent
+  Gaussian noise of standard deviation Params::noiseSigma to u and v (so the reprojection RMS per
+  coordinate equals noiseSigma).
+- Partial tracks (Params::partialFraction of all tracks, chosen at random) are observed only on
+  one random contiguous range of frames, at least 20% of the sequence long and shorter than it;
+  both `tracks` and `cleanTracks` are NaN outside that range.
+- Outlier tracks (Params::outlierFraction, chosen at random, flagged in `outlierTrack`) are 2D
+  random walks that follow no 3D point; their `groundTruth.points` row is NaN and their
+  `cleanTracks` hold the same 2D positions as `tracks` (no noise is added to them), so both
+  matrices have the same NaN pattern.
+
+Masks are CV_8U, 255 inside, 0 outside; `visibleMasks` are the pixels where `labels` names the
+object, so they are always inside `wholeMasks`. Depth is camera-space z (Camera::depth); the ground
+is a 120 x 120 square, so the depth is +inf only where the sky shows (perspective views with a
+wide field of view).
 */
 struct CV_EXPORTS SyntheticScene
 {
@@ -41,13 +63,37 @@ struct CV_EXPORTS SyntheticScene
 /** @brief Renders, headless through OSMesa, a textured static scene (a ground plane and several
 real objects: a box building in front, an L-shaped block, a mushroom-shaped tower like the paper's
 hotel) seen by a camera orbiting far away, with its ground truth. Deterministic for a seed.
+
+Objects (names as in SyntheticScene::objectNames): "building" (a box in front), "lblock" (an
+L-shaped, non-convex block on the left), "tower" (a narrow round shaft under a wide cap and a
+conical roof, behind). The building hides part of the tower early in the default orbit and part of
+the L-block late in it.
+
+Camera: it looks at the scene centre from distance D = distanceRatio * scene size, at azimuth
+swept linearly over orbitDegrees (centred on the +z axis) and elevation elevationDegrees, with a
+small smooth hand-held jitter (about 1 degree) in elevation and roll. SCALED_ORTHOGRAPHIC uses one
+constant s for the whole sequence so that the scene fills about 60% of the frame width (its
+cameras also sit at distance D, so that depths are positive); PERSPECTIVE uses f = s * D, i.e.
+the same framing at the scene centre. Principal point at the image centre ((W-1)/2, (H-1)/2).
+
+Lighting: see src/shading.hpp (ambient + one directional light fixed in the world, per-vertex
+Lambertian shading, diffuse texture modulated); renderWithVirtual() draws virtual meshes with it.
+
+Rendering happens on the calling thread with one offscreen OpenGL context owned by the object and
+reused by every call; calls on one object are serialized by a mutex. Each call makes that context
+current on the calling thread.
 */
 class CV_EXPORTS SceneSynthesizer : public Algorithm
 {
 public:
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
+        /** Defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg).
+        Valid ranges (setParams() throws StsBadArg/StsOutOfRange otherwise): frames >= 2, both image
+        sides >= 32, distanceRatio >= 1, orbitDegrees in [0, 360], elevationDegrees in (0, 90),
+        numTracks >= 1, noiseSigma >= 0, fractions in [0, 1] with partial + outlier <= 1,
+        numKeyFrames in [2, frames]. */
+        Params();
         int frames;                         //!< number of frames (default 60)
         Size imageSize;                     //!< frame size (default 640x480)
         CameraModel model;                  //!< camera model of the frames (default SCALED_ORTHOGRAPHIC)
@@ -62,10 +108,12 @@ public:
         uint64 seed;                        //!< random seed (textures, points, noise) (default 1)
     };
 
+    //! Creates a synthesizer; throws as setParams() does on invalid parameters.
     static Ptr<SceneSynthesizer> create(const Params& params);
     //! Creates a synthesizer with default Params.
     static Ptr<SceneSynthesizer> create();
     virtual Params getParams() const = 0;
+    //! Validates and sets the parameters (see Params for the ranges).
     virtual void setParams(const Params& params) = 0;
 
     //! Synthesizes the whole sequence with its ground truth.
@@ -80,6 +128,26 @@ public:
     */
     virtual void renderWithVirtual(int frame, const std::vector<Mesh>& virtualObjects,
                                    OutputArray image, int supersample = 1) const = 0;
+
+    /** @brief Renders one frame with its per-frame ground truth: the per-frame part of
+    synthesize(), for the perf suite and for tools that need a single frame.
+    @param frame frame index in [0, frames).
+    @param image output BGR CV_8UC3, identical to SyntheticScene::frames[frame].
+    @param depth optional output CV_32F camera-space z (+inf where nothing).
+    @param labels optional output CV_8U, 0 ground/sky, i + 1 where object i is seen.
+    @param wholeMasks optional output, one CV_8U mask per object (objectNames() order), each
+    object rendered as if alone.
+    */
+    virtual void renderFrame(int frame, OutputArray image, OutputArray depth = noArray(),
+                             OutputArray labels = noArray(),
+                             OutputArrayOfArrays wholeMasks = noArray()) const = 0;
+
+    //! True camera of a frame (the same as SyntheticScene::groundTruth.camera(frame)).
+    virtual Camera getCamera(int frame) const = 0;
+    //! Names of the real objects, in label order.
+    virtual std::vector<String> getObjectNames() const = 0;
+    //! True geometry of the real objects (world coordinates, textured), in label order.
+    virtual std::vector<Mesh> getObjectMeshes() const = 0;
 };
 
 //! @}
