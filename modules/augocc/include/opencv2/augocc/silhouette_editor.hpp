@@ -56,11 +56,17 @@ public:
         //! Canny thresholds of the edge feature (default 32, 100, as in OpenCV's scissors demo).
         double cannyLow, cannyHigh;
         //! LIVE_WIRE clicks are moved to the strongest edge pixel within this radius (pixels,
-        //! default 3; 0 keeps the click as given).
+        //! default 2; 0 keeps the click as given).
         int clickSnapRadius;
         //! Live wire is searched inside the bounding box of its two anchors grown by this margin
         //! (pixels, default 24): bounded cost, and no detour through far-away texture.
         int searchMargin;
+        //! Once a contour is closed its outside is known: live-wire pixels up to outerEdgeBand
+        //! pixels inside the chord of their segment cost up to outerEdgeBias more (gradient-
+        //! magnitude feature, range [0, 1]), so the wire takes the outer of two parallel edges
+        //! (a silhouette rather than a trim just inside it). Defaults 0.5 and 4; 0 disables.
+        float outerEdgeBias;
+        int outerEdgeBand;
         //! loadMask(): tolerance of the polygon approximation of a mask outline (pixels,
         //! default 1.0).
         double outlineTolerance;
@@ -71,6 +77,10 @@ public:
         //! Contours whose area is below this are ignored when a mask is loaded (pixels,
         //! default 20).
         double minContourArea;
+        //! getMask(): a live-wire pixel on the mask's boundary is kept only when its colour is
+        //! nearer to the inside neighbour's than to the outside one's (the wire runs on edge
+        //! pixels, which belong to either side). Default true.
+        bool refineBoundary;
     };
 
     /** @brief Creates an editor.
