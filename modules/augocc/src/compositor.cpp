@@ -10,6 +10,9 @@
 #include "gl_context.hpp"
 #include "compositor_shading.hpp"
 
+#include <map>
+#include <tuple>
+#include <unordered_map>
 #include <GL/osmesa.h>
 #include <GL/gl.h>
 
@@ -39,7 +42,7 @@ Camera supersampledCamera(const Camera& camera, int factor)
 }
 
 Compositor::Params::Params()
-    : supersample(3)
+    : supersample(3), cullBackFaces(true)
 {
 }
 
@@ -51,6 +54,7 @@ typedef void (*PfnGenBuffers)(GLsizei, GLuint*);
 typedef void (*PfnDeleteBuffers)(GLsizei, const GLuint*);
 typedef void (*PfnBindBuffer)(GLenum, GLuint);
 typedef void (*PfnBufferData)(GLenum, ptrdiff_t, const void*, GLenum);
+typedef void (*PfnWindowPos2i)(GLint, GLint);
 const GLenum kArrayBuffer = 0x8892;         // GL_ARRAY_BUFFER
 const GLenum kElementArrayBuffer = 0x8893;  // GL_ELEMENT_ARRAY_BUFFER
 const GLenum kStaticDraw = 0x88E4;          // GL_STATIC_DRAW
@@ -61,6 +65,7 @@ struct GlBufferApi
     PfnDeleteBuffers deleteBuffers = nullptr;
     PfnBindBuffer bindBuffer = nullptr;
     PfnBufferData bufferData = nullptr;
+    PfnWindowPos2i windowPos2i = nullptr;
 
     void load()
     {
@@ -70,8 +75,9 @@ struct GlBufferApi
         deleteBuffers = (PfnDeleteBuffers)OSMesaGetProcAddress("glDeleteBuffers");
         bindBuffer = (PfnBindBuffer)OSMesaGetProcAddress("glBindBuffer");
         bufferData = (PfnBufferData)OSMesaGetProcAddress("glBufferData");
-        if (!genBuffers || !deleteBuffers || !bindBuffer || !bufferData)
-            CV_Error(Error::StsError, "OSMesa: vertex buffer objects are not available");
+        windowPos2i = (PfnWindowPos2i)OSMesaGetProcAddress("glWindowPos2i");
+        if (!genBuffers || !deleteBuffers || !bindBuffer || !bufferData || !windowPos2i)
+            CV_Error(Error::StsError, "OSMesa: OpenGL 1.5 entry points are not available");
     }
 };
 
@@ -89,7 +95,52 @@ struct GpuMesh
 {
     GLuint vbo = 0, ibo = 0, texture = 0;
     GLsizei indexCount = 0;
+    bool cull = false;  // closed and outward: back faces are never seen
 };
+
+// True when the mesh is closed and consistently oriented with outward normals (vertices welded by
+// position, so that per-face copies of a vertex count as one): then its back faces are always
+// hidden by its front faces and culling them changes no pixel.
+bool closedOutward(const Mesh& m)
+{
+    if (m.faces.empty())
+        return false;
+    // Weld on a grid of 1e-6 of the mesh's size: seams computed as sin(2 pi) land together.
+    Vec3f lo, hi;
+    m.bounds(lo, hi);
+    const double cell = std::max(1e-30, 1e-6 * cv::norm(hi - lo));
+    std::map<std::tuple<int64_t, int64_t, int64_t>, int> weld;
+    std::vector<int> id(m.vertices.size());
+    for (size_t i = 0; i < m.vertices.size(); i++)
+    {
+        const Vec3f& v = m.vertices[i];
+        const auto key = std::make_tuple((int64_t)std::llround((v[0] - lo[0]) / cell),
+                                         (int64_t)std::llround((v[1] - lo[1]) / cell),
+                                         (int64_t)std::llround((v[2] - lo[2]) / cell));
+        id[i] = weld.emplace(key, (int)weld.size()).first->second;
+    }
+    std::unordered_map<uint64_t, int> directed;
+    directed.reserve(m.faces.size() * 3);
+    double volume6 = 0;
+    for (const Vec3i& f : m.faces)
+    {
+        // Degenerate triangles (a sphere's poles) cover no pixel: they do not count.
+        if (id[f[0]] == id[f[1]] || id[f[1]] == id[f[2]] || id[f[2]] == id[f[0]])
+            continue;
+        for (int e = 0; e < 3; e++)
+        {
+            const uint64_t a = (uint64_t)id[f[e]], b = (uint64_t)id[f[(e + 1) % 3]];
+            if (++directed[(a << 32) | b] > 1)
+                return false;  // an edge used twice in one direction: not consistently oriented
+        }
+        const Vec3d p0(m.vertices[f[0]]), p1(m.vertices[f[1]]), p2(m.vertices[f[2]]);
+        volume6 += p0.dot(p1.cross(p2));
+    }
+    for (const auto& e : directed)
+        if (!directed.count(((e.first & 0xffffffffu) << 32) | (e.first >> 32)))
+            return false;  // a border edge: the mesh is open
+    return volume6 > 0;
+}
 
 class CompositorImpl CV_FINAL : public Compositor
 {
@@ -100,6 +151,8 @@ public:
     Params getParams() const CV_OVERRIDE { return params_; }
     void setParams(const Params& p) CV_OVERRIDE
     {
+        if (p.cullBackFaces != params_.cullBackFaces)
+            dirty_ = true;
         if (p.supersample < 1 || p.supersample > 8)
             CV_Error(Error::StsBadArg, cv::format("Compositor: supersample must be in [1, 8], "
                      "got %d", p.supersample));
@@ -190,52 +243,66 @@ public:
         ensureContext(rsz);
         uploadIfDirty();
 
-        // Depth range that holds the virtual objects and the occluders.
+        // Depth range that holds the virtual objects. Occluders nearer than the near plane clamp
+        // to window depth 0 (they hide everything), farther than the far plane to 1 (nothing).
         double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
         if (!meshes_.empty())
             for (int c = 0; c < 8; c++)
             {
-                const Vec3d p((c & 1) ? boundsMax_[0] : boundsMin_[0],
-                              (c & 2) ? boundsMax_[1] : boundsMin_[1],
-                              (c & 4) ? boundsMax_[2] : boundsMin_[2]);
-                const double z = camera.depth(p);
+                const double z = camera.depth(boundsCorner(c));
                 zmin = std::min(zmin, z);
                 zmax = std::max(zmax, z);
             }
-        const bool anyVirtual = !meshes_.empty() && zmax > zmin - 1;
         double zNear = 0, zFar = 1;
-        chooseDepthRange(camera, zmin, zmax, occ, zNear, zFar);
+        chooseDepthRange(camera, zmin, zmax, zNear, zFar);
+        const Camera rc = supersampledCamera(camera, k);
+        // Only the part of the render grid where the virtual objects can appear is drawn, read
+        // back and blended (a multiple of k, so that it maps onto whole frame pixels).
+        const Rect roi = meshes_.empty() ? Rect() : screenRoi(rc, rsz, k, zNear);
 
-        glClearColor(0, 0, 0, 0);
-        glClearDepth(1.0);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        glDisable(GL_CULL_FACE);
-        glDisable(GL_LIGHTING);
-        glDisable(GL_BLEND);
-        glDisable(GL_DITHER);
-        glEnable(GL_DEPTH_TEST);
+        Mat rgba;  // frame grid, ROI only, rows bottom-up
+        Mat zRoi;  // render grid, ROI only, camera z of the nearest surface (depth output)
+        if (roi.area() > 0)
+        {
+            const int winY = rsz.height - roi.y - roi.height;
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(roi.x, winY, roi.width, roi.height);
+            glClearColor(0, 0, 0, 0);
+            glClearDepth(1.0);
+            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            glDisable(GL_LIGHTING);
+            glDisable(GL_BLEND);
+            glDisable(GL_DITHER);
+            glEnable(GL_DEPTH_TEST);
 
-        if (!occ.empty() && anyVirtual)
-            drawOccluderDepth(camera, occ, zNear, zFar, rsz);
+            if (!occ.empty())
+                drawOccluderDepth(camera, occ(roi), zNear, zFar, roi.tl(), winY);
+            drawMeshes(rc, rsz, zNear, zFar);
 
-        if (anyVirtual)
-            drawMeshes(supersampledCamera(camera, k), rsz, zNear, zFar);
-
-        // Read back the render grid (bottom row first), box-average to the frame grid.
-        glFinish();
-        Mat rgbaUp(rsz, CV_8UC4);
-        glPixelStorei(GL_PACK_ALIGNMENT, 4);
-        glReadPixels(0, 0, rsz.width, rsz.height, GL_RGBA, GL_UNSIGNED_BYTE, rgbaUp.data);
-        Mat rgba;
-        if (k > 1)
-            cv::resize(rgbaUp, rgba, fsz, 0, 0, INTER_AREA);
-        else
-            rgba = rgbaUp;
-
-        blend(frame, rgba, result, virtualLayer);
-
+            glFinish();
+            Mat rgbaUp(roi.size(), CV_8UC4);
+            glPixelStorei(GL_PACK_ALIGNMENT, 4);
+            glReadPixels(roi.x, winY, roi.width, roi.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                         rgbaUp.data);
+            if (k > 1)
+                cv::resize(rgbaUp, rgba, Size(roi.width / k, roi.height / k), 0, 0, INTER_AREA);
+            else
+                rgba = rgbaUp;
+            if (depthOut.needed())
+            {
+                Mat d(roi.size(), CV_32F), flipped;
+                glPixelStorei(GL_PACK_ALIGNMENT, 4);
+                glReadPixels(roi.x, winY, roi.width, roi.height, GL_DEPTH_COMPONENT, GL_FLOAT,
+                             d.data);
+                cv::flip(d, flipped, 0);
+                detail::windowDepthToCameraZ(camera, flipped, zNear, zFar, zRoi);
+            }
+            glDisable(GL_SCISSOR_TEST);
+        }
+        const Rect froi(roi.x / k, roi.y / k, roi.width / k, roi.height / k);
+        blend(frame, rgba, froi, result, virtualLayer);
         if (depthOut.needed())
-            readDepth(camera, occ, zNear, zFar, rsz, fsz, k, anyVirtual, depthOut);
+            writeDepth(occ, zRoi, roi, rsz, fsz, k, depthOut);
     }
 
 private:
@@ -244,7 +311,7 @@ private:
         if (!gl_)
         {
             gl_.reset(new detail::GlContext(rsz));
-            buffers_.load();
+            glApi_.load();
         }
         else if (gl_->size() != rsz)
             gl_->resize(rsz);
@@ -260,9 +327,9 @@ private:
         for (GpuMesh& g : gpu_)
         {
             if (g.vbo)
-                buffers_.deleteBuffers(1, &g.vbo);
+                glApi_.deleteBuffers(1, &g.vbo);
             if (g.ibo)
-                buffers_.deleteBuffers(1, &g.ibo);
+                glApi_.deleteBuffers(1, &g.ibo);
             if (g.texture)
                 glDeleteTextures(1, &g.texture);
         }
@@ -297,21 +364,22 @@ private:
                 }
             });
             GpuMesh g;
-            buffers_.genBuffers(1, &g.vbo);
-            buffers_.bindBuffer(kArrayBuffer, g.vbo);
-            buffers_.bufferData(kArrayBuffer, (ptrdiff_t)(verts.size() * sizeof(GpuVertex)),
+            glApi_.genBuffers(1, &g.vbo);
+            glApi_.bindBuffer(kArrayBuffer, g.vbo);
+            glApi_.bufferData(kArrayBuffer, (ptrdiff_t)(verts.size() * sizeof(GpuVertex)),
                                 verts.data(), kStaticDraw);
-            buffers_.genBuffers(1, &g.ibo);
-            buffers_.bindBuffer(kElementArrayBuffer, g.ibo);
-            buffers_.bufferData(kElementArrayBuffer, (ptrdiff_t)(m.faces.size() * sizeof(Vec3i)),
+            glApi_.genBuffers(1, &g.ibo);
+            glApi_.bindBuffer(kElementArrayBuffer, g.ibo);
+            glApi_.bufferData(kElementArrayBuffer, (ptrdiff_t)(m.faces.size() * sizeof(Vec3i)),
                                 m.faces.data(), kStaticDraw);
             g.indexCount = (GLsizei)(m.faces.size() * 3);
+            g.cull = params_.cullBackFaces && closedOutward(m);
             if (hasTex)
                 g.texture = uploadTexture(m.material.texture);
             gpu_.push_back(g);
         }
-        buffers_.bindBuffer(kArrayBuffer, 0);
-        buffers_.bindBuffer(kElementArrayBuffer, 0);
+        glApi_.bindBuffer(kArrayBuffer, 0);
+        glApi_.bindBuffer(kElementArrayBuffer, 0);
         dirty_ = false;
     }
 
@@ -354,28 +422,16 @@ private:
         return tex;
     }
 
-    // Near/far planes in camera z that hold the virtual objects (and, in front of them, the
-    // occluders that matter). The depth buffer is 24-bit; a tight range keeps the comparison of
-    // clone and virtual depth exact to far below a clone voxel.
-    static void chooseDepthRange(const Camera& cam, double zmin, double zmax, const Mat& occ,
-                                 double& zNear, double& zFar)
+    // Near/far planes in camera z around the virtual objects, with a 5% margin. The depth
+    // buffer is 24-bit; a tight range keeps the comparison of clone and virtual depth exact to
+    // far below a clone voxel.
+    static void chooseDepthRange(const Camera& cam, double zmin, double zmax, double& zNear,
+                                 double& zFar)
     {
         if (!(zmax >= zmin))
         {
             zmin = 0;
             zmax = 1;
-        }
-        if (!occ.empty())
-        {
-            // Occluders farther than every virtual point never hide anything; nearer ones only
-            // need to be in front (clamped to the near plane).
-            double omin = 0, omax = 0;
-            Mat finite = occ < std::numeric_limits<float>::infinity();
-            if (cv::countNonZero(finite) > 0)
-            {
-                cv::minMaxLoc(occ, &omin, &omax, nullptr, nullptr, finite);
-                zmin = std::min(zmin, omin);
-            }
         }
         const double range = std::max(zmax - zmin, 1e-6 * std::max(1.0, std::abs(zmax)));
         if (cam.model == SCALED_ORTHOGRAPHIC)
@@ -393,6 +449,43 @@ private:
         }
     }
 
+    Vec3d boundsCorner(int c) const
+    {
+        return Vec3d((c & 1) ? boundsMax_[0] : boundsMin_[0], (c & 2) ? boundsMax_[1] : boundsMin_[1],
+                     (c & 4) ? boundsMax_[2] : boundsMin_[2]);
+    }
+
+    // Render-grid rectangle that holds the projection of the virtual objects' bounding box
+    // (2 pixels of margin for the rasteriser's edge rule), aligned to k. The whole grid when a
+    // corner lies behind the near plane of a perspective camera.
+    Rect screenRoi(const Camera& rc, Size rsz, int k, double zNear) const
+    {
+        double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+        for (int c = 0; c < 8; c++)
+        {
+            const Vec3d X = boundsCorner(c);
+            if (rc.model == PERSPECTIVE && rc.depth(X) <= zNear)
+                return Rect(0, 0, rsz.width, rsz.height);
+            const Point2d u = rc.project(X);
+            x0 = std::min(x0, u.x);
+            x1 = std::max(x1, u.x);
+            y0 = std::min(y0, u.y);
+            y1 = std::max(y1, u.y);
+        }
+        const double kMargin = 2.0;
+        const double W = rsz.width, H = rsz.height;
+        x0 = std::max(0.0, std::floor(x0 - kMargin));
+        y0 = std::max(0.0, std::floor(y0 - kMargin));
+        x1 = std::min(W, std::ceil(x1 + kMargin) + 1);
+        y1 = std::min(H, std::ceil(y1 + kMargin) + 1);
+        if (!(x1 > x0 && y1 > y0))
+            return Rect();
+        const int ix0 = ((int)x0 / k) * k, iy0 = ((int)y0 / k) * k;
+        const int ix1 = std::min(rsz.width, (((int)x1 + k - 1) / k) * k);
+        const int iy1 = std::min(rsz.height, (((int)y1 + k - 1) / k) * k);
+        return Rect(ix0, iy0, ix1 - ix0, iy1 - iy0);
+    }
+
     // Window depth of camera z for glProjection(cam, ..., zNear, zFar): (ndc + 1) / 2.
     static inline float windowDepth(bool ortho, double z, double zNear, double zFar)
     {
@@ -408,29 +501,27 @@ private:
 
     // The clones go into the depth buffer only (colour writes off), as window depth of the same
     // projection the virtual objects use; rows bottom-up as GL expects.
-    void drawOccluderDepth(const Camera& cam, const Mat& occ, double zNear, double zFar, Size rsz)
+    void drawOccluderDepth(const Camera& cam, const Mat& occ, double zNear, double zFar,
+                           Point origin, int winY)
     {
         const bool ortho = cam.model == SCALED_ORTHOGRAPHIC;
-        windowBuf_.create(rsz, CV_32F);
-        cv::parallel_for_(Range(0, rsz.height), [&](const Range& r) {
+        const Size sz = occ.size();
+        windowBuf_.create(sz, CV_32F);
+        cv::parallel_for_(Range(0, sz.height), [&](const Range& r) {
             for (int y = r.start; y < r.end; y++)
             {
                 const float* src = occ.ptr<float>(y);
-                float* dst = windowBuf_.ptr<float>(rsz.height - 1 - y);
-                for (int x = 0; x < rsz.width; x++)
+                float* dst = windowBuf_.ptr<float>(sz.height - 1 - y);
+                for (int x = 0; x < sz.width; x++)
                     dst[x] = windowDepth(ortho, src[x], zNear, zFar);
             }
         });
-        glMatrixMode(GL_PROJECTION);
-        glLoadIdentity();
-        glMatrixMode(GL_MODELVIEW);
-        glLoadIdentity();
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         glDepthMask(GL_TRUE);
         glDepthFunc(GL_ALWAYS);
-        glRasterPos2f(-1.f, -1.f);
+        glApi_.windowPos2i(origin.x, winY);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        glDrawPixels(rsz.width, rsz.height, GL_DEPTH_COMPONENT, GL_FLOAT, windowBuf_.data);
+        glDrawPixels(sz.width, sz.height, GL_DEPTH_COMPONENT, GL_FLOAT, windowBuf_.data);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     }
 
@@ -447,10 +538,19 @@ private:
         glEnableClientState(GL_VERTEX_ARRAY);
         glEnableClientState(GL_COLOR_ARRAY);
         glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+        // Window y points up like the viewer's up (glProjection), so a triangle that is
+        // counter-clockwise seen from outside is counter-clockwise in the window when it faces
+        // the camera.
+        glFrontFace(GL_CCW);
+        glCullFace(GL_BACK);
         for (const GpuMesh& g : gpu_)
         {
-            buffers_.bindBuffer(kArrayBuffer, g.vbo);
-            buffers_.bindBuffer(kElementArrayBuffer, g.ibo);
+            if (g.cull)
+                glEnable(GL_CULL_FACE);
+            else
+                glDisable(GL_CULL_FACE);
+            glApi_.bindBuffer(kArrayBuffer, g.vbo);
+            glApi_.bindBuffer(kElementArrayBuffer, g.ibo);
             glVertexPointer(3, GL_FLOAT, sizeof(GpuVertex), (const void*)offsetof(GpuVertex, x));
             glColorPointer(3, GL_FLOAT, sizeof(GpuVertex), (const void*)offsetof(GpuVertex, r));
             if (g.texture)
@@ -469,51 +569,57 @@ private:
                 glDisable(GL_TEXTURE_2D);
             }
         }
+        glDisable(GL_CULL_FACE);
         glDisableClientState(GL_VERTEX_ARRAY);
         glDisableClientState(GL_COLOR_ARRAY);
-        buffers_.bindBuffer(kArrayBuffer, 0);
-        buffers_.bindBuffer(kElementArrayBuffer, 0);
+        glApi_.bindBuffer(kArrayBuffer, 0);
+        glApi_.bindBuffer(kElementArrayBuffer, 0);
     }
 
-    // result = frame * (1 - a) + premultiplied colour; the layer with straight alpha. `rgba` rows
-    // are bottom-up (GL), RGB order.
-    static void blend(const Mat& frame, const Mat& rgba, OutputArray resultArr,
+    // result = frame * (1 - a) + premultiplied colour, inside `roi` (frame grid); the frame
+    // elsewhere. The layer has straight alpha. `rgba` rows are bottom-up (GL), RGB order.
+    static void blend(const Mat& frame, const Mat& rgba, const Rect& roi, OutputArray resultArr,
                       OutputArray layerArr)
     {
         const Size sz = frame.size();
         resultArr.create(sz, CV_8UC3);
         Mat result = resultArr.getMat();
+        frame.copyTo(result);
         Mat layer;
         if (layerArr.needed())
         {
             layerArr.create(sz, CV_8UC4);
             layer = layerArr.getMat();
+            layer.setTo(Scalar::all(0));
         }
-        cv::parallel_for_(Range(0, sz.height), [&](const Range& r) {
-            for (int y = r.start; y < r.end; y++)
+        if (roi.area() == 0)
+            return;
+        cv::parallel_for_(Range(0, roi.height), [&](const Range& r) {
+            for (int j = r.start; j < r.end; j++)
             {
-                const uchar* f = frame.ptr<uchar>(y);
-                const uchar* c = rgba.ptr<uchar>(sz.height - 1 - y);
-                uchar* o = result.ptr<uchar>(y);
-                uchar* l = layer.empty() ? nullptr : layer.ptr<uchar>(y);
-                for (int x = 0; x < sz.width; x++, f += 3, c += 4, o += 3)
+                const int y = roi.y + j;
+                const uchar* f = frame.ptr<uchar>(y) + 3 * roi.x;
+                const uchar* c = rgba.ptr<uchar>(roi.height - 1 - j);
+                uchar* o = result.ptr<uchar>(y) + 3 * roi.x;
+                uchar* l = layer.empty() ? nullptr : layer.ptr<uchar>(y) + 4 * roi.x;
+                for (int x = 0; x < roi.width; x++, f += 3, c += 4, o += 3)
                 {
                     const int a = c[3];
+                    if (a == 0)
+                    {
+                        if (l)
+                            l += 4;
+                        continue;
+                    }
                     const int ia = 255 - a;
-                    // Premultiplied: colour <= alpha up to rounding of the box average.
                     o[0] = saturate_cast<uchar>((c[2] * 255 + f[0] * ia + 127) / 255);
                     o[1] = saturate_cast<uchar>((c[1] * 255 + f[1] * ia + 127) / 255);
                     o[2] = saturate_cast<uchar>((c[0] * 255 + f[2] * ia + 127) / 255);
                     if (l)
                     {
-                        if (a > 0)
-                        {
-                            l[0] = saturate_cast<uchar>((c[2] * 255 + a / 2) / a);
-                            l[1] = saturate_cast<uchar>((c[1] * 255 + a / 2) / a);
-                            l[2] = saturate_cast<uchar>((c[0] * 255 + a / 2) / a);
-                        }
-                        else
-                            l[0] = l[1] = l[2] = 0;
+                        l[0] = saturate_cast<uchar>((c[2] * 255 + a / 2) / a);
+                        l[1] = saturate_cast<uchar>((c[1] * 255 + a / 2) / a);
+                        l[2] = saturate_cast<uchar>((c[0] * 255 + a / 2) / a);
                         l[3] = (uchar)a;
                         l += 4;
                     }
@@ -522,33 +628,29 @@ private:
         });
     }
 
-    void readDepth(const Camera& cam, const Mat& occ, double zNear, double zFar, Size rsz,
-                   Size fsz, int k, bool anyVirtual, OutputArray depthOut)
+    // Depth output at the frame grid: per pixel the minimum over its k x k samples of the
+    // occluder depth and (inside the ROI) the depth buffer read back.
+    static void writeDepth(const Mat& occ, const Mat& zRoi, const Rect& roi, Size rsz, Size fsz,
+                           int k, OutputArray depthOut)
     {
+        const float inf = std::numeric_limits<float>::infinity();
         Mat zUp;
-        if (anyVirtual)
-        {
-            glFinish();
-            Mat d(rsz, CV_32F), flipped;
-            glPixelStorei(GL_PACK_ALIGNMENT, 4);
-            glReadPixels(0, 0, rsz.width, rsz.height, GL_DEPTH_COMPONENT, GL_FLOAT, d.data);
-            cv::flip(d, flipped, 0);
-            detail::windowDepthToCameraZ(cam, flipped, zNear, zFar, zUp);
-            // Occluders clamped to the planes read back inexactly: take theirs where nearer.
-            if (!occ.empty())
-                cv::min(zUp, occ, zUp);
-        }
-        else if (!occ.empty())
-            zUp = occ;
+        if (!occ.empty())
+            occ.copyTo(zUp);
         else
-            zUp = Mat(rsz, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
+            zUp = Mat(rsz, CV_32F, Scalar::all(inf));
+        if (roi.area() > 0)
+        {
+            Mat sub = zUp(roi);
+            cv::min(sub, zRoi, sub);
+        }
         depthOut.create(fsz, CV_32F);
         Mat out = depthOut.getMat();
         cv::parallel_for_(Range(0, fsz.height), [&](const Range& r) {
             for (int y = r.start; y < r.end; y++)
                 for (int x = 0; x < fsz.width; x++)
                 {
-                    float m = std::numeric_limits<float>::infinity();
+                    float m = inf;
                     for (int j = 0; j < k; j++)
                     {
                         const float* row = zUp.ptr<float>(y * k + j) + x * k;
@@ -565,7 +667,7 @@ private:
     Vec3d boundsMin_, boundsMax_;
     bool dirty_ = true;
     std::unique_ptr<detail::GlContext> gl_;
-    GlBufferApi buffers_;
+    GlBufferApi glApi_;
     std::vector<GpuMesh> gpu_;
     Mat windowBuf_;
 };

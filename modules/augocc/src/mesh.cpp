@@ -309,8 +309,7 @@ Mesh Mesh::dome(float radius, int segments, int rings)
 
 void writeMeshPly(const String& path, const Mesh& mesh)
 {
-    if (mesh.vertices.empty())
-        CV_Error(Error::StsBadArg, path + ": writeMeshPly: the mesh has no vertex");
+    // An empty mesh is a valid PLY with no element (e.g. a key frame that needs no patch voxel).
     const size_t nv = mesh.vertices.size();
     for (const Vec3i& f : mesh.faces)
         for (int k = 0; k < 3; k++)

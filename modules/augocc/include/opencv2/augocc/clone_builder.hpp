@@ -4,10 +4,24 @@
 #ifndef OPENCV_AUGOCC_CLONE_BUILDER_HPP
 #define OPENCV_AUGOCC_CLONE_BUILDER_HPP
 
+#include <map>
 #include <vector>
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/io.hpp"
+
+/*
+Clones (the paper's Section 6 @cite Ong1998). Conventions:
+- A clone is a dense voxel grid whose axes are the columns of a rotation `Rbox` (box axes in world
+  coordinates); voxel (i, j, k) has its centre at origin + Rbox * (voxelSize * (i + 0.5, j + 0.5,
+  k + 0.5)).
+- The footprint of a voxel in an image is the set of pixel centres inside the bounding rectangle
+  of its projected cube, plus the pixel its centre rounds to. Carving keeps a voxel only when its
+  whole footprint lies in the silhouette (or in an "unknown" pixel), and render() draws exactly
+  the footprints: one rule, so that in a key frame the clone never covers a pixel outside the
+  silhouette and the patch voxels make up the rest exactly.
+- Depth is camera-space z (CONTRACT.md) of the nearest voxel centre.
+*/
 
 namespace cv {
 namespace augocc {
@@ -18,8 +32,7 @@ namespace augocc {
 /** @brief The clones of the real objects (the paper's Section 6): per object a dense voxel grid
 (the trimmed model) and a set of patch voxels per key frame.
 
-This is what the compositor and `augocc matte` consume. (Outline fixed by the foundation; the
-clone builder's work extends it.)
+This is what the compositor and `augocc matte` consume. Made by CloneBuilder::build() or load().
 */
 class CV_EXPORTS CloneSet
 {
@@ -44,7 +57,125 @@ public:
     virtual void save(const String& path) const = 0;
     //! Loads a file written by save(); throws naming the file on error.
     static Ptr<CloneSet> load(const String& path);
+
+    //! Key frames of an object (frames holding a patch set), increasing.
+    virtual std::vector<int> keyFrames(const String& object) const = 0;
+    //! The key frame whose patch voxels apply to `frame` (per the builder's patch-frame rule).
+    virtual std::vector<int> patchFrames(const String& object, int frame) const = 0;
+    //! Number of voxels of the trimmed model (without patches).
+    virtual int voxelCount(const String& object) const = 0;
+    //! Number of patch voxels of one key frame (0 when `keyFrame` is not a key frame).
+    virtual int patchVoxelCount(const String& object, int keyFrame) const = 0;
+    //! Grid dimensions (nx, ny, nz) of an object's voxel grid.
+    virtual Vec3i gridSize(const String& object) const = 0;
+    //! Voxel edge length in world units.
+    virtual double voxelSize(const String& object) const = 0;
+    /** @brief Box of an object's grid: rotation whose columns are the box axes in world
+    coordinates, and the world position of the grid's corner (voxel (0,0,0)'s outer corner). */
+    virtual void gridPose(const String& object, Matx33d& Rbox, Vec3d& origin) const = 0;
+    /** @brief Writes `DIR/<object>_clone.ply` (the trimmed model's surface as quads split into
+    triangles) and `DIR/<object>_patches_%04d.ply` (one per key frame, patch voxels as cubes), to
+    open in MeshLab or Blender. Creates DIR when needed. */
+    virtual void exportPly(const String& dir) const = 0;
 };
+
+/** @brief Builds clones of real objects from a reconstruction and key-frame silhouettes (the
+paper's Section 6, Steps 1-5), with the extensions documented in doc/clones.md: robust point
+clustering, automatic box orientation, occlusion-aware carving, both camera models, several rays
+per pixel for patches and an incremental key frame.
+*/
+class CV_EXPORTS CloneBuilder : public Algorithm
+{
+public:
+    //! Step 2: how the box (and the voxel grid) is oriented.
+    enum Orientation
+    {
+        ORIENT_AUTO = 0,  //!< vertical from the cameras' horizontal x axes, then least footprint
+        ORIENT_WORLD = 1, //!< the reconstruction's axes (the paper's initial box)
+        ORIENT_USER = 2   //!< Params::userRotation (the paper's interactive rotation)
+    };
+    //! Which key frames' patch voxels apply to a frame that is not a key frame.
+    enum PatchRule
+    {
+        PATCH_NEAREST = 0,   //!< the nearest key frame (the paper); ties go to the earlier one
+        PATCH_BRACKETING = 1 //!< both key frames around the frame (the nearest outside the range)
+    };
+
+    struct CV_EXPORTS Params
+    {
+        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
+        //! Voxel edge in pixels of the key frame that sees the object largest (default 1: a voxel
+        //! projects to at most about one pixel, the paper's rule).
+        double voxelPixels;
+        //! Upper bound on voxels per object; the voxel grows to respect it (default 2^27).
+        int64 maxVoxels;
+        //! Step 3: passes over the key frames while enlarging the box (default 20).
+        int maxEnlargeIterations;
+        //! Step 2: Orientation (default ORIENT_AUTO).
+        int orientation;
+        //! ORIENT_USER: Rodrigues vector (radians) of the box axes in world coordinates.
+        Vec3d userRotation;
+        //! Step 5: rays per pixel along each image axis, n x n per pixel (default 2).
+        int raysPerPixel;
+        //! PatchRule for frames that are not key frames (default PATCH_NEAREST).
+        int patchRule;
+        //! Step 4: pixels under a nearer object's silhouette are unknown, not outside (default true).
+        bool occlusionAware;
+        //! Step 1: fraction of points trimmed at each end of every box axis (default 0.02).
+        double trimFraction;
+        //! Step 1: fewer clustered points than this and the box comes from the silhouettes alone
+        //! (default 4).
+        int minPoints;
+    };
+
+    static Ptr<CloneBuilder> create(const Params& params);
+    //! Creates a builder with default Params.
+    static Ptr<CloneBuilder> create();
+    virtual Params getParams() const = 0;
+    //! Validates and sets the parameters (StsBadArg naming the field when out of range).
+    virtual void setParams(const Params& params) = 0;
+
+    /** @brief Builds one clone per object of `keyFrameMasks`.
+    @param rec cameras (every key frame needs one) and 3D points (may be empty: then each box comes
+    from the silhouettes alone).
+    @param keyFrameMasks per object, the user's silhouettes in its key frames (CV_8U, > 127 = in,
+    the reconstruction's image size).
+    @param tracks optional: the tracks `rec.points` came from; when given, a point is clustered by
+    the key frames in which its track is observed, else by every key frame where it projects.
+    @return the clone set.
+    Throws StsBadArg / StsBadSize naming the object and frame for an empty or all-white mask, a mask
+    of the wrong size or for a frame with no camera.
+    */
+    virtual Ptr<CloneSet> build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                                const Tracks* tracks = nullptr) const = 0;
+
+    /** @brief Adds one key frame to an existing clone: carves with that frame only and recomputes
+    the object's patch voxels, without starting over.
+    @param clones a set made by build() or CloneSet::load().
+    @param rec the reconstruction (camera of `frame`).
+    @param object object name (must exist in `clones`).
+    @param frame the new key frame (replaces the silhouette if it is already a key frame).
+    @param mask its silhouette (CV_8U, > 127 = in).
+    */
+    virtual void addKeyFrame(CloneSet& clones, const Reconstruction& rec, const String& object,
+                             int frame, InputArray mask) const = 0;
+};
+
+/** @brief Renders every object's matte (and optionally depth) in every frame of `rec`.
+@param clones the clones.
+@param rec the reconstruction (one matte per camera).
+@param mattes output, object -> frame -> CV_8U matte (0 / 255).
+@param depth optional output, object -> frame -> CV_32F camera-space z (+inf off the clone).
+*/
+CV_EXPORTS void renderMattes(const CloneSet& clones, const Reconstruction& rec,
+                             ObjectMasks& mattes,
+                             std::map<String, std::map<int, Mat> >* depth = nullptr);
+
+/** @brief Writes the contract's mattes folder `DIR/<object>/%04d.png` for every frame of `rec`,
+and, when `depthDir` is not empty, `depthDir/<object>/%04d.tiff` (32-bit float camera-space z,
++inf off the clone). Both folders are written atomically. */
+CV_EXPORTS void writeMattes(const String& dir, const CloneSet& clones, const Reconstruction& rec,
+                            const String& depthDir = String());
 
 //! @}
 

@@ -54,6 +54,10 @@ public:
         the paper's hard depth test; 3 makes occlusion edges soft (see doc/compositor.md for the
         measured error). */
         int supersample;
+        /** Cull the back faces of meshes that are closed and outward-oriented (checked per mesh
+        when uploaded; such back faces are never visible, so no pixel changes). Halves the
+        triangles the rasteriser sets up (default true). */
+        bool cullBackFaces;
     };
 
     static Ptr<Compositor> create(const Params& params);

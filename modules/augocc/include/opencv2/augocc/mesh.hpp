@@ -59,7 +59,8 @@ struct CV_EXPORTS Mesh
 };
 
 /** @brief Writes a mesh as binary little-endian PLY (vertices, faces, per-vertex colours and normals
-when present). A mesh with no faces is written as a point cloud. Atomic (temporary + rename). */
+when present). A mesh with no faces is written as a point cloud, an empty mesh as a valid PLY
+with no element. Atomic (temporary + rename). */
 CV_EXPORTS void writeMeshPly(const String& path, const Mesh& mesh);
 
 /** @brief Loads every mesh of a file through Assimp (OBJ, PLY, glTF/GLB, and the other formats

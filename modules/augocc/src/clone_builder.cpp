@@ -1,0 +1,725 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// CloneBuilder: the paper's Section 6, Steps 1-4 (Step 5 and the clone set are in clone_set.cpp).
+
+#include "precomp.hpp"
+#include "clone_internal.hpp"
+
+namespace cv {
+namespace augocc {
+
+CloneBuilder::Params::Params()
+    : voxelPixels(1.0), maxVoxels((int64)1 << 27), maxEnlargeIterations(20),
+      orientation(ORIENT_AUTO), userRotation(0, 0, 0), raysPerPixel(2), patchRule(PATCH_NEAREST),
+      occlusionAware(true), trimFraction(0.02), minPoints(4)
+{
+}
+
+namespace {
+
+using namespace detail;
+
+// Grid margin in voxels around the enlarged box: room for patch voxels just outside it.
+const int kGridMarginVoxels = 2;
+// Step 2 (auto): the cameras' x axes must span the horizontal plane for the vertical to be their
+// common normal: second eigenvalue / largest of their scatter above this (about a 3 degree spread).
+const double kMinHorizontalSpread = 1e-3;
+// Step 2 (auto): footprint-area search over the rotation about the vertical, in degrees.
+const double kAzimuthStepDeg = 1.0;
+
+// An oriented box: axes are the columns of R (world), extent [lo, hi] in box coordinates.
+struct Box
+{
+    Matx33d R = Matx33d::eye();
+    Vec3d lo, hi;
+    bool valid = false;
+
+    void include(const Vec3d& b)
+    {
+        if (!valid)
+        {
+            lo = hi = b;
+            valid = true;
+            return;
+        }
+        for (int a = 0; a < 3; a++)
+        {
+            lo[a] = std::min(lo[a], b[a]);
+            hi[a] = std::max(hi[a], b[a]);
+        }
+    }
+    Vec3d toBox(const Vec3d& X) const { return R.t() * X; }
+    Vec3d toWorld(const Vec3d& b) const { return R * b; }
+    Vec3d corner(int c) const
+    {
+        return toWorld(Vec3d(c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]));
+    }
+    Vec3d centre() const { return toWorld(0.5 * (lo + hi)); }
+};
+
+struct ObjectWork
+{
+    String name;
+    const FrameMasks* masks = nullptr;
+    std::vector<Vec3d> points;   // Step 1
+    Box box;                     // Steps 2-3
+    bool fromSilhouettes = false;
+};
+
+void checkMask(const Mat& m, const Reconstruction& rec, const String& object, int frame)
+{
+    const String where = cv::format("masks of object '%s', frame %d", object.c_str(), frame);
+    if (m.empty())
+        CV_Error(Error::StsBadArg, where + ": empty image");
+    if (m.type() != CV_8UC1)
+        CV_Error(Error::StsBadArg, where + ": must be 8-bit single channel");
+    if (m.size() != rec.imageSize)
+        CV_Error(Error::StsBadSize, where + cv::format(": size %dx%d differs from the "
+                 "reconstruction's %dx%d", m.cols, m.rows, rec.imageSize.width,
+                 rec.imageSize.height));
+    if (rec.findCamera(frame) < 0)
+        CV_Error(Error::StsBadArg, where + ": the reconstruction has no camera for this frame");
+    const int n = countNonZero(m > 127);
+    if (n == 0)
+        CV_Error(Error::StsBadArg, where + ": the silhouette is empty");
+    if (n == (int)m.total())
+        CV_Error(Error::StsBadArg, where + ": the silhouette covers the whole frame (all white)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Step 1: clustering
+
+std::vector<Vec3d> clusterPoints(const Reconstruction& rec, const ObjectMasks& all,
+                                 const String& object, const Tracks* tracks)
+{
+    std::vector<Vec3d> out;
+    if (rec.points.empty())
+        return out;
+    const FrameMasks& masks = all.at(object);
+    const int P = rec.points.rows;
+    const Rect img(Point(0, 0), rec.imageSize);
+    for (int p = 0; p < P; p++)
+    {
+        const double* q = rec.points.ptr<double>(p);
+        if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+            continue;
+        const Vec3d X(q[0], q[1], q[2]);
+        int inCount = 0;
+        bool ok = true;
+        for (const auto& fm : masks)
+        {
+            const int f = fm.first;
+            if (tracks && (f >= tracks->frames() || !tracks->observed(f, p)))
+                continue;
+            const Point2d uv = rec.project(f, X);
+            const Point px(cvRound(uv.x), cvRound(uv.y));
+            if (!img.contains(px))
+            {
+                if (tracks)
+                    ok = false;  // seen in the frame but projects off it: inconsistent point
+                continue;
+            }
+            if (fm.second.at<uchar>(px) > 127)
+            {
+                inCount++;
+                continue;
+            }
+            // Under another object's silhouette the point may be hidden there: no evidence.
+            bool hidden = false;
+            for (const auto& other : all)
+            {
+                if (other.first == object)
+                    continue;
+                auto it = other.second.find(f);
+                if (it != other.second.end() && it->second.at<uchar>(px) > 127)
+                {
+                    hidden = true;
+                    break;
+                }
+            }
+            if (!hidden)
+            {
+                ok = false;
+                break;
+            }
+        }
+        if (ok && inCount > 0)
+            out.push_back(X);
+    }
+    return out;
+}
+
+// Trimmed extent of values: [q, 1 - q] quantiles.
+void trimmedRange(std::vector<double>& v, double trim, double& lo, double& hi)
+{
+    std::sort(v.begin(), v.end());
+    const int n = (int)v.size();
+    const int cut = std::min((int)std::floor(trim * n), (n - 1) / 2);
+    lo = v[cut];
+    hi = v[n - 1 - cut];
+}
+
+Box robustBox(const std::vector<Vec3d>& pts, const Matx33d& R, double trim)
+{
+    Box b;
+    b.R = R;
+    std::vector<double> c[3];
+    for (const Vec3d& X : pts)
+    {
+        const Vec3d y = R.t() * X;
+        for (int a = 0; a < 3; a++)
+            c[a].push_back(y[a]);
+    }
+    for (int a = 0; a < 3; a++)
+        trimmedRange(c[a], trim, b.lo[a], b.hi[a]);
+    b.valid = true;
+    return b;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Step 2: orientation
+
+Vec3d estimateVertical(const Reconstruction& rec)
+{
+    Matx33d S = Matx33d::zeros();
+    Vec3d down(0, 0, 0);
+    for (const Camera& c : rec.cameras)
+    {
+        const Vec3d x(c.R(0, 0), c.R(0, 1), c.R(0, 2));
+        S += x * x.t();
+        down += Vec3d(c.R(1, 0), c.R(1, 1), c.R(1, 2));
+    }
+    Mat evals, evecs;
+    eigen(Mat(S), evals, evecs);  // descending
+    Vec3d up = -down;
+    if (evals.at<double>(1) > kMinHorizontalSpread * evals.at<double>(0))
+    {
+        // Cameras that orbit without roll keep their x axis horizontal: the vertical is normal to
+        // every x axis, the scatter's least eigenvector.
+        Vec3d e(evecs.at<double>(2, 0), evecs.at<double>(2, 1), evecs.at<double>(2, 2));
+        up = e.dot(up) < 0 ? -e : e;
+    }
+    return up / cv::norm(up);
+}
+
+Matx33d basisFromUp(const Vec3d& up, const Vec3d& hint)
+{
+    Vec3d a = hint - up * hint.dot(up);
+    if (cv::norm(a) < 1e-9)
+    {
+        a = std::abs(up[0]) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 0, 1);
+        a = a - up * a.dot(up);
+    }
+    a /= cv::norm(a);
+    const Vec3d b = a.cross(up);
+    return Matx33d(a[0], up[0], b[0], a[1], up[1], b[1], a[2], up[2], b[2]);
+}
+
+Matx33d autoOrientation(const Reconstruction& rec, const std::vector<Vec3d>& pts, double trim,
+                        int minPoints)
+{
+    const Vec3d up = estimateVertical(rec);
+    Vec3d meanX(0, 0, 0);
+    for (const Camera& c : rec.cameras)
+        meanX += Vec3d(c.R(0, 0), c.R(0, 1), c.R(0, 2));
+    const Matx33d B0 = basisFromUp(up, meanX);
+    if ((int)pts.size() < minPoints)
+        return B0;
+    // Least footprint area about the vertical (buildings: aligned with their facades).
+    const Vec3d a0(B0(0, 0), B0(1, 0), B0(2, 0)), b0(B0(0, 2), B0(1, 2), B0(2, 2));
+    double bestArea = std::numeric_limits<double>::infinity(), bestTheta = 0;
+    std::vector<double> ca(pts.size()), cb(pts.size());
+    for (double deg = 0; deg < 90.0; deg += kAzimuthStepDeg)
+    {
+        const double th = deg * CV_PI / 180.0;
+        const Vec3d a = std::cos(th) * a0 + std::sin(th) * b0;
+        const Vec3d b = a.cross(up);
+        for (size_t i = 0; i < pts.size(); i++)
+        {
+            ca[i] = pts[i].dot(a);
+            cb[i] = pts[i].dot(b);
+        }
+        double l0, h0, l1, h1;
+        trimmedRange(ca, trim, l0, h0);
+        trimmedRange(cb, trim, l1, h1);
+        const double area = (h0 - l0) * (h1 - l1);
+        if (area < bestArea - 1e-12)
+        {
+            bestArea = area;
+            bestTheta = th;
+        }
+    }
+    const Vec3d a = std::cos(bestTheta) * a0 + std::sin(bestTheta) * b0;
+    return basisFromUp(up, a);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fallback: the box bounding the intersection of the back-projected silhouette rectangles (an LP
+// per box face; each rectangle edge is a half-space for both camera models).
+
+Box boxFromSilhouettes(const Reconstruction& rec, const FrameMasks& masks, const Matx33d& R,
+                       const String& object)
+{
+    std::vector<Vec4d> rows;  // a . Y <= b  as (a0, a1, a2, b)
+    for (const auto& fm : masks)
+    {
+        const Rect r = boundingRect(fm.second > 127);
+        const Camera& cam = rec.camera(fm.first);
+        const Matx34d P = cam.projectionMatrix();
+        Vec3d pr[3];
+        double p4[3];
+        for (int i = 0; i < 3; i++)
+        {
+            const Vec3d row(P(i, 0), P(i, 1), P(i, 2));
+            pr[i] = R.t() * row;  // row . X = row . (R Y) = (R^T row) . Y
+            p4[i] = P(i, 3);
+        }
+        const double ulo = r.x - 0.5, uhi = r.x + r.width - 0.5;
+        const double vlo = r.y - 0.5, vhi = r.y + r.height - 0.5;
+        // u >= ulo  <=>  (p0 - ulo p2) . Y + (p04 - ulo p24) >= 0 (w > 0)
+        const double lim[4] = {ulo, uhi, vlo, vhi};
+        for (int e = 0; e < 4; e++)
+        {
+            const int axis = e / 2;
+            const Vec3d a = pr[axis] - lim[e] * pr[2];
+            const double c = p4[axis] - lim[e] * p4[2];
+            if (e % 2 == 0)
+                rows.push_back(Vec4d(-a[0], -a[1], -a[2], c));
+            else
+                rows.push_back(Vec4d(a[0], a[1], a[2], -c));
+        }
+    }
+    // Free variables Y = Y+ - Y-, all >= 0, as cv::solveLP requires.
+    Mat A((int)rows.size(), 7, CV_64F);
+    for (int i = 0; i < (int)rows.size(); i++)
+    {
+        double* a = A.ptr<double>(i);
+        for (int k = 0; k < 3; k++)
+        {
+            a[k] = rows[i][k];
+            a[k + 3] = -rows[i][k];
+        }
+        a[6] = rows[i][3];
+    }
+    Box b;
+    b.R = R;
+    for (int axis = 0; axis < 3; axis++)
+        for (int sgn = -1; sgn <= 1; sgn += 2)
+        {
+            Mat f = Mat::zeros(1, 6, CV_64F), z;
+            f.at<double>(axis) = sgn;
+            f.at<double>(axis + 3) = -sgn;
+            const int res = solveLP(f, A, z);
+            if (res == SOLVELP_UNFEASIBLE)
+                CV_Error(Error::StsBadArg, "object '" + object + "': its key-frame silhouettes "
+                         "are inconsistent with the cameras (their back-projections do not meet)");
+            if (res == SOLVELP_UNBOUNDED)
+                CV_Error(Error::StsBadArg, "object '" + object + "': no reconstructed point falls "
+                         "in its silhouettes and the key frames do not bound it (need views from "
+                         "at least two directions)");
+            const double y = z.at<double>(axis) - z.at<double>(axis + 3);
+            if (sgn > 0)
+                b.hi[axis] = y;
+            else
+                b.lo[axis] = y;
+        }
+    b.valid = true;
+    return b;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Step 3: enlargement
+
+// True when the ray meets the box (a line for the orthographic model, a half line else).
+bool rayHitsBox(const Box& box, const Ray& ray, bool halfLine)
+{
+    const Vec3d o = box.toBox(ray.origin), d = box.toBox(ray.direction);
+    double t0 = halfLine ? 0.0 : -std::numeric_limits<double>::infinity();
+    double t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; a++)
+    {
+        if (std::abs(d[a]) < 1e-15)
+        {
+            if (o[a] < box.lo[a] || o[a] > box.hi[a])
+                return false;
+            continue;
+        }
+        double ta = (box.lo[a] - o[a]) / d[a], tb = (box.hi[a] - o[a]) / d[a];
+        if (ta > tb)
+            std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        if (t0 > t1)
+            return false;
+    }
+    return true;
+}
+
+// The paper: corner C of the box nearest the ray, then the point of the ray nearest C joins the
+// box. Returns true when the box grew.
+bool enlargeForPixel(Box& box, const Camera& cam, const Point2d& px)
+{
+    const Ray ray = cam.backproject(px);
+    const bool half = cam.model == PERSPECTIVE;
+    if (rayHitsBox(box, ray, half))
+        return false;
+    double best = std::numeric_limits<double>::infinity();
+    Vec3d bestX;
+    for (int c = 0; c < 8; c++)
+    {
+        const Vec3d C = box.corner(c);
+        double t = (C - ray.origin).dot(ray.direction);
+        if (half)
+            t = std::max(t, 0.0);
+        const Vec3d X = ray.at(t);
+        const double d = cv::norm(X - C);
+        if (d < best)
+        {
+            best = d;
+            bestX = X;
+        }
+    }
+    const Vec3d lo0 = box.lo, hi0 = box.hi;
+    box.include(box.toBox(bestX));
+    return box.lo != lo0 || box.hi != hi0;
+}
+
+// Per key frame: the extreme silhouette points on each edge of its bounding rectangle (eight or
+// fewer), the paper's test points.
+std::vector<Point> extremeEdgePoints(const Mat& bin)
+{
+    std::vector<Point> pts;
+    const Rect r = boundingRect(bin);
+    const int xs[2] = {r.x, r.x + r.width - 1}, ys[2] = {r.y, r.y + r.height - 1};
+    for (int e = 0; e < 2; e++)
+    {
+        // Top and bottom rows: leftmost and rightmost silhouette pixel.
+        const uchar* row = bin.ptr<uchar>(ys[e]);
+        int a = -1, b = -1;
+        for (int x = r.x; x < r.x + r.width; x++)
+            if (row[x])
+            {
+                if (a < 0) a = x;
+                b = x;
+            }
+        if (a >= 0)
+        {
+            pts.push_back(Point(a, ys[e]));
+            if (b != a) pts.push_back(Point(b, ys[e]));
+        }
+        // Left and right columns: topmost and bottommost.
+        a = b = -1;
+        for (int y = r.y; y < r.y + r.height; y++)
+            if (bin.at<uchar>(y, xs[e]))
+            {
+                if (a < 0) a = y;
+                b = y;
+            }
+        if (a >= 0)
+        {
+            pts.push_back(Point(xs[e], a));
+            if (b != a) pts.push_back(Point(xs[e], b));
+        }
+    }
+    return pts;
+}
+
+// Silhouette pixels the box's projection misses: the vertices of their convex hull.
+std::vector<Point> uncoveredHull(const Box& box, const Camera& cam, const Mat& bin)
+{
+    std::vector<Point> proj;
+    const int shift = 8;
+    for (int c = 0; c < 8; c++)
+    {
+        const Point2d p = cam.project(box.corner(c));
+        proj.push_back(Point(cvRound(p.x * (1 << shift)), cvRound(p.y * (1 << shift))));
+    }
+    std::vector<Point> hull;
+    convexHull(proj, hull);
+    Mat cover(bin.size(), CV_8U, Scalar(0));
+    fillConvexPoly(cover, hull, Scalar(255), LINE_8, shift);
+    // One pixel of slack: rasterisation and the exact ray test may disagree on the border.
+    dilate(cover, cover, Mat());
+    Mat miss = bin & ~cover;
+    std::vector<Point> pts, out;
+    findNonZero(miss, pts);
+    if (pts.empty())
+        return out;
+    convexHull(pts, out);
+    return out;
+}
+
+void enlargeBox(Box& box, const Reconstruction& rec, const std::map<int, Mat>& bins, int maxIter)
+{
+    for (int it = 0; it < maxIter; it++)
+    {
+        bool grew = false;
+        for (const auto& fm : bins)
+        {
+            const Camera& cam = rec.camera(fm.first);
+            for (const Point& p : extremeEdgePoints(fm.second))
+                grew |= enlargeForPixel(box, cam, Point2d(p));
+        }
+        // Beyond the eight points: any silhouette part the box still misses (a silhouette may
+        // bulge beyond the hull of the eight points).
+        for (const auto& fm : bins)
+        {
+            const Camera& cam = rec.camera(fm.first);
+            for (const Point& p : uncoveredHull(box, cam, fm.second))
+                grew |= enlargeForPixel(box, cam, Point2d(p));
+        }
+        if (!grew)
+            return;
+    }
+    CV_LOG_WARNING(NULL, "augocc: box enlargement stopped after maxEnlargeIterations passes");
+}
+
+// ---------------------------------------------------------------------------------------------
+
+class CloneBuilderImpl CV_FINAL : public CloneBuilder
+{
+public:
+    explicit CloneBuilderImpl(const Params& p) { setParams(p); }
+
+    Params getParams() const CV_OVERRIDE { return params_; }
+
+    void setParams(const Params& p) CV_OVERRIDE
+    {
+        if (!(p.voxelPixels > 0) || !std::isfinite(p.voxelPixels))
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::voxelPixels must be positive");
+        if (p.maxVoxels < 8)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::maxVoxels must be at least 8");
+        if (p.maxEnlargeIterations < 1)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::maxEnlargeIterations must be >= 1");
+        if (p.orientation < ORIENT_AUTO || p.orientation > ORIENT_USER)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::orientation is not an Orientation");
+        if (p.raysPerPixel < 1 || p.raysPerPixel > 8)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::raysPerPixel must be in [1, 8]");
+        if (p.patchRule != PATCH_NEAREST && p.patchRule != PATCH_BRACKETING)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::patchRule is not a PatchRule");
+        if (!(p.trimFraction >= 0 && p.trimFraction < 0.5))
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::trimFraction must be in [0, 0.5)");
+        if (p.minPoints < 1)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::minPoints must be >= 1");
+        params_ = p;
+    }
+
+    Ptr<CloneSet> build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                        const Tracks* tracks) const CV_OVERRIDE;
+    void addKeyFrame(CloneSet& clones, const Reconstruction& rec, const String& object,
+                     int frame, InputArray mask) const CV_OVERRIDE;
+
+private:
+    Matx33d orientationFor(const Reconstruction& rec, const std::vector<Vec3d>& pts) const
+    {
+        if (params_.orientation == ORIENT_WORLD)
+            return Matx33d::eye();
+        if (params_.orientation == ORIENT_USER)
+            return rotationFromRodrigues(params_.userRotation);
+        return autoOrientation(rec, pts, params_.trimFraction, params_.minPoints);
+    }
+
+    void makeGrid(ObjectClone& obj, const Box& box, const Reconstruction& rec) const;
+
+    Params params_;
+};
+
+void CloneBuilderImpl::makeGrid(ObjectClone& obj, const Box& box, const Reconstruction& rec) const
+{
+    // Voxel edge: voxelPixels pixels in the key frame that sees the box largest.
+    double ppu = 0;
+    for (const auto& fm : obj.masks)
+    {
+        const Camera& cam = rec.camera(fm.first);
+        double zmin = std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 8; c++)
+            zmin = std::min(zmin, cam.depth(box.corner(c)));
+        if (cam.model == PERSPECTIVE && !(zmin > 0))
+            CV_Error(Error::StsBadArg, cv::format("object '%s': its box reaches behind the camera "
+                     "of key frame %d", obj.name.c_str(), fm.first));
+        ppu = std::max(ppu, cam.pixelsPerUnit(zmin));
+    }
+    double h = params_.voxelPixels / ppu;
+    Vec3d ext = box.hi - box.lo;
+    Vec3i dims;
+    for (int attempt = 0; attempt < 64; attempt++)
+    {
+        for (int a = 0; a < 3; a++)
+            dims[a] = std::max(1, (int)std::ceil(ext[a] / h)) + 2 * kGridMarginVoxels;
+        const double total = (double)dims[0] * dims[1] * dims[2];
+        const int maxDim = std::max(dims[0], std::max(dims[1], dims[2]));
+        double grow = 1.0;
+        if (total > (double)params_.maxVoxels)
+            grow = std::max(grow, std::cbrt(total / (double)params_.maxVoxels) * 1.001);
+        if (maxDim > kMaxGridDim)
+            grow = std::max(grow, (double)maxDim / kMaxGridDim * 1.001);
+        if (grow <= 1.0)
+            break;
+        h *= grow;
+    }
+    if (h > params_.voxelPixels / ppu * 1.0001)
+        CV_LOG_INFO(NULL, cv::format("augocc: object '%s': voxel enlarged to %.3g px to respect "
+                                     "maxVoxels", obj.name.c_str(), h * ppu));
+    // Centre the grid on the box.
+    const Vec3d size(dims[0] * h, dims[1] * h, dims[2] * h);
+    const Vec3d loBox = 0.5 * (box.lo + box.hi) - 0.5 * size;
+    obj.grid.create(dims, box.R, box.toWorld(loBox), h, 1);
+}
+
+// Unknown pixels of `object` in `frame`: silhouettes of the other objects nearer the camera.
+Mat unknownMask(const std::map<String, ObjectClone>& objs, const String& object, int frame,
+                const Camera& cam, Size size)
+{
+    Mat unknown(size, CV_8U, Scalar(0));
+    const double z = cam.depth(objs.at(object).centre);
+    for (const auto& o : objs)
+    {
+        if (o.first == object)
+            continue;
+        auto it = o.second.masks.find(frame);
+        if (it == o.second.masks.end())
+            continue;
+        if (cam.depth(o.second.centre) < z)
+            unknown |= it->second;
+    }
+    return unknown;
+}
+
+void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
+                   const Reconstruction& rec, const std::vector<int>& carveFrames,
+                   bool occlusionAware, int raysPerPixel)
+{
+    std::vector<CarveView> views(carveFrames.size());
+    parallel_for_(Range(0, (int)carveFrames.size()), [&](const Range& r) {
+        for (int q = r.start; q < r.end; q++)
+        {
+            const int f = carveFrames[q];
+            const Camera& cam = rec.camera(f);
+            Mat keep = obj.masks.at(f).clone();
+            if (occlusionAware)
+                keep |= unknownMask(objs, obj.name, f, cam, keep.size());
+            views[q] = obj.grid.carveView(cam, keep);
+        }
+    });
+    obj.grid.carve(views);
+    obj.surface = obj.grid.surface();
+    // Step 5 for every key frame (the clone changed, so every patch set is redone).
+    std::vector<int> keys;
+    for (const auto& m : obj.masks)
+        keys.push_back(m.first);
+    std::vector<std::vector<uint32_t> > patches(keys.size());
+    parallel_for_(Range(0, (int)keys.size()), [&](const Range& r) {
+        for (int q = r.start; q < r.end; q++)
+        {
+            const int f = keys[q];
+            const Camera& cam = rec.camera(f);
+            const Mat& sil = obj.masks.at(f);
+            Mat keep = sil.clone();
+            if (occlusionAware)
+                keep |= unknownMask(objs, obj.name, f, cam, keep.size());
+            patches[q] = computePatches(obj, cam, sil, keep, raysPerPixel);
+        }
+    });
+    obj.patches.clear();
+    for (size_t q = 0; q < keys.size(); q++)
+        obj.patches[keys[q]] = std::move(patches[q]);
+}
+
+Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                                      const Tracks* tracks) const
+{
+    if (keyFrameMasks.empty())
+        CV_Error(Error::StsBadArg, "CloneBuilder::build: no object masks");
+    if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
+        CV_Error(Error::StsBadSize, "CloneBuilder::build: the reconstruction has no image size");
+    if (tracks && !rec.points.empty() && tracks->points() != rec.points.rows)
+        CV_Error(Error::StsBadSize, cv::format("CloneBuilder::build: tracks have %d columns, the "
+                 "reconstruction %d points", tracks->points(), rec.points.rows));
+    if (!rec.points.empty() && (rec.points.cols != 3 || rec.points.type() != CV_64FC1))
+        CV_Error(Error::StsBadArg, "CloneBuilder::build: reconstruction points must be Nx3 CV_64F");
+    ObjectMasks bins;
+    for (const auto& o : keyFrameMasks)
+    {
+        if (o.second.empty())
+            CV_Error(Error::StsBadArg, "CloneBuilder::build: object '" + o.first +
+                     "' has no key frame");
+        for (const auto& fm : o.second)
+        {
+            checkMask(fm.second, rec, o.first, fm.first);
+            bins[o.first][fm.first] = fm.second > 127;
+        }
+    }
+
+    Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
+    set->patchRule = params_.patchRule;
+    // Steps 1-3 per object.
+    for (const auto& o : bins)
+    {
+        std::vector<Vec3d> pts = clusterPoints(rec, bins, o.first, tracks);
+        const Matx33d R = orientationFor(rec, pts);
+        Box box;
+        Vec3d centre;
+        if ((int)pts.size() >= params_.minPoints)
+        {
+            box = robustBox(pts, R, params_.trimFraction);
+            centre = box.centre();
+        }
+        else
+        {
+            CV_LOG_INFO(NULL, cv::format("augocc: object '%s': %d reconstructed points in its "
+                        "silhouettes; box from the silhouettes alone", o.first.c_str(),
+                        (int)pts.size()));
+            box = boxFromSilhouettes(rec, o.second, R, o.first);
+            centre = box.centre();
+        }
+        enlargeBox(box, rec, o.second, params_.maxEnlargeIterations);
+        ObjectClone& obj = set->objects[o.first];
+        obj.name = o.first;
+        obj.centre = centre;
+        obj.masks = o.second;
+        for (auto& m : obj.masks)
+            m.second = m.second.clone();
+        makeGrid(obj, box, rec);
+    }
+    // Steps 4-5 per object (unknown pixels need every object's centre).
+    for (auto& o : set->objects)
+    {
+        std::vector<int> frames;
+        for (const auto& m : o.second.masks)
+            frames.push_back(m.first);
+        carveAndPatch(set->objects, o.second, rec, frames, params_.occlusionAware,
+                      params_.raysPerPixel);
+    }
+    return set;
+}
+
+void CloneBuilderImpl::addKeyFrame(CloneSet& clones, const Reconstruction& rec,
+                                   const String& object, int frame, InputArray mask) const
+{
+    CloneSetImpl* set = dynamic_cast<CloneSetImpl*>(&clones);
+    if (!set)
+        CV_Error(Error::StsBadArg, "addKeyFrame: the clone set was not made by CloneBuilder or "
+                 "CloneSet::load");
+    ObjectClone& obj = set->get(object);
+    Mat m = mask.getMat();
+    checkMask(m, rec, object, frame);
+    obj.masks[frame] = m > 127;
+    carveAndPatch(set->objects, obj, rec, std::vector<int>(1, frame), params_.occlusionAware,
+                  params_.raysPerPixel);
+}
+
+} // namespace
+
+Ptr<CloneBuilder> CloneBuilder::create(const Params& params)
+{
+    return makePtr<CloneBuilderImpl>(params);
+}
+
+Ptr<CloneBuilder> CloneBuilder::create()
+{
+    return makePtr<CloneBuilderImpl>(Params());
+}
+
+} // namespace augocc
+} // namespace cv

@@ -1,0 +1,62 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#ifndef OPENCV_AUGOCC_CLONE_INTERNAL_HPP
+#define OPENCV_AUGOCC_CLONE_INTERNAL_HPP
+
+#include <map>
+#include <vector>
+#include "opencv2/augocc/clone_builder.hpp"
+#include "voxel_grid.hpp"
+
+namespace cv {
+namespace augocc {
+namespace detail {
+
+//! One object's clone: the trimmed model, its surface, and per key frame the silhouette and the
+//! patch voxels (packed coordinates, sorted).
+struct ObjectClone
+{
+    String name;
+    VoxelGrid grid;
+    SurfaceVoxels surface;
+    Vec3d centre;                                   //!< world point used to order objects by depth
+    std::map<int, Mat> masks;                       //!< key-frame silhouettes (0 / 255)
+    std::map<int, std::vector<uint32_t> > patches;  //!< key frame -> patch voxels
+};
+
+//! The CloneSet implementation shared by the builder, load() and the tests.
+class CloneSetImpl CV_FINAL : public CloneSet
+{
+public:
+    std::map<String, ObjectClone> objects;
+    int patchRule = CloneBuilder::PATCH_NEAREST;
+
+    std::vector<String> objectNames() const CV_OVERRIDE;
+    void render(const String& object, int frame, const Camera& camera, Size imageSize,
+                OutputArray matte, OutputArray depth) const CV_OVERRIDE;
+    void save(const String& path) const CV_OVERRIDE;
+    std::vector<int> keyFrames(const String& object) const CV_OVERRIDE;
+    std::vector<int> patchFrames(const String& object, int frame) const CV_OVERRIDE;
+    int voxelCount(const String& object) const CV_OVERRIDE;
+    int patchVoxelCount(const String& object, int keyFrame) const CV_OVERRIDE;
+    Vec3i gridSize(const String& object) const CV_OVERRIDE;
+    double voxelSize(const String& object) const CV_OVERRIDE;
+    void gridPose(const String& object, Matx33d& Rbox, Vec3d& origin) const CV_OVERRIDE;
+    void exportPly(const String& dir) const CV_OVERRIDE;
+
+    const ObjectClone& get(const String& object) const;
+    ObjectClone& get(const String& object);
+};
+
+/** @brief Step 5 for one key frame: the patch voxels that make the clone cover `silhouette`
+exactly (the paper's two-pass algorithm, several rays per pixel). `keep` (silhouette or unknown)
+bounds where patch footprints may fall. */
+std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camera,
+                                     const Mat& silhouette, const Mat& keep, int raysPerPixel);
+
+} // namespace detail
+} // namespace augocc
+} // namespace cv
+
+#endif

@@ -1,0 +1,572 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// CloneSet: rendering (matte + depth), patch voxels (the paper's Step 5), file I/O, PLY export and
+// the mattes folder.
+
+#include "precomp.hpp"
+#include "clone_internal.hpp"
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+namespace cv {
+namespace augocc {
+
+CloneSet::~CloneSet() {}
+
+namespace detail {
+
+namespace fsys = std::filesystem;
+
+namespace {
+
+// Step 5: extra rounds of candidate patch voxels for pixels the first round left uncovered, each
+// with one more ray per pixel along each axis and the depth range widened by one voxel.
+const int kPatchExtraRounds = 2;
+// Samples along a ray segment per voxel edge (two: no voxel the segment crosses is skipped).
+const double kSamplesPerVoxel = 2.0;
+
+Mat paddedKeep(const Mat& keep, int pad)
+{
+    Mat k01 = keep != 0, out;
+    copyMakeBorder(k01, out, pad, pad, pad, pad, BORDER_CONSTANT, Scalar(255));
+    return out;
+}
+
+} // namespace
+
+std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camera,
+                                     const Mat& silhouette, const Mat& keep, int raysPerPixel)
+{
+    const VoxelGrid& g = obj.grid;
+    const Size size = silhouette.size();
+    const VoxelProjector proj = g.projector(camera, size);
+    Mat zmin(size, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+    splatVoxels(proj, obj.surface.ijk.data(), obj.surface.faces.data(), obj.surface.size(), true,
+                zmin, nullptr);
+    Mat zfar(size, CV_32F, Scalar(-std::numeric_limits<float>::infinity()));
+    Mat zdummy(size, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+    splatVoxels(proj, obj.surface.ijk.data(), nullptr, obj.surface.size(), false, zdummy, &zfar);
+
+    // First pass: d1 / d2 where the clone is hit; the missing pixels are the rest of the silhouette.
+    const int W = size.width, H = size.height;
+    Mat d1(size, CV_32F, Scalar(0)), d2(size, CV_32F, Scalar(0));
+    Mat state(size, CV_8U, Scalar(0));  // 0 not in play, 1 known, 2 missing
+    std::vector<Point> missing;
+    double sum1 = 0, sum2 = 0;
+    int nknown = 0;
+    for (int y = 0; y < H; y++)
+    {
+        const float* zr = zmin.ptr<float>(y);
+        const float* zf = zfar.ptr<float>(y);
+        const uchar* s = silhouette.ptr<uchar>(y);
+        for (int x = 0; x < W; x++)
+        {
+            if (zr[x] < std::numeric_limits<float>::infinity())
+            {
+                state.at<uchar>(y, x) = 1;
+                d1.at<float>(y, x) = zr[x];
+                d2.at<float>(y, x) = std::max(zf[x], zr[x]);
+                sum1 += zr[x];
+                sum2 += std::max(zf[x], zr[x]);
+                nknown++;
+            }
+            else if (s[x])
+            {
+                state.at<uchar>(y, x) = 2;
+                missing.push_back(Point(x, y));
+            }
+        }
+    }
+    if (missing.empty())
+        return std::vector<uint32_t>();
+
+    // Second pass: d1 / d2 of missing pixels from their eight neighbours, in order of distance from
+    // the known pixels (one ring at a time, each ring from the rings before it only).
+    std::vector<Point> ring;
+    for (const Point& p : missing)
+    {
+        bool near = false;
+        for (int dy = -1; dy <= 1 && !near; dy++)
+            for (int dx = -1; dx <= 1; dx++)
+            {
+                const int x = p.x + dx, y = p.y + dy;
+                if (x >= 0 && y >= 0 && x < W && y < H && state.at<uchar>(y, x) == 1)
+                {
+                    near = true;
+                    break;
+                }
+            }
+        if (near)
+            ring.push_back(p);
+    }
+    std::vector<float> v1, v2;
+    while (!ring.empty())
+    {
+        v1.assign(ring.size(), 0.f);
+        v2.assign(ring.size(), 0.f);
+        for (size_t q = 0; q < ring.size(); q++)
+        {
+            double a = 0, b = 0;
+            int n = 0;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++)
+                {
+                    const int x = ring[q].x + dx, y = ring[q].y + dy;
+                    if (x >= 0 && y >= 0 && x < W && y < H && state.at<uchar>(y, x) == 1)
+                    {
+                        a += d1.at<float>(y, x);
+                        b += d2.at<float>(y, x);
+                        n++;
+                    }
+                }
+            v1[q] = (float)(a / n);
+            v2[q] = (float)(b / n);
+        }
+        for (size_t q = 0; q < ring.size(); q++)
+        {
+            d1.at<float>(ring[q]) = v1[q];
+            d2.at<float>(ring[q]) = v2[q];
+            state.at<uchar>(ring[q]) = 3;  // assigned in this ring
+        }
+        std::vector<Point> next;
+        for (const Point& p : ring)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++)
+                {
+                    const int x = p.x + dx, y = p.y + dy;
+                    if (x >= 0 && y >= 0 && x < W && y < H && state.at<uchar>(y, x) == 2)
+                    {
+                        state.at<uchar>(y, x) = 4;  // queued
+                        next.push_back(Point(x, y));
+                    }
+                }
+        for (const Point& p : ring)
+            state.at<uchar>(p) = 1;
+        ring.swap(next);
+    }
+    // Missing islands with no known pixel around: the clone's mean depth range, or the grid's.
+    float f1, f2;
+    if (nknown > 0)
+    {
+        f1 = (float)(sum1 / nknown);
+        f2 = (float)(sum2 / nknown);
+    }
+    else
+    {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (int c = 0; c < 8; c++)
+        {
+            const Vec3d X = g.centre(c & 1 ? g.dims[0] - 0.5 : -0.5, c & 2 ? g.dims[1] - 0.5 : -0.5,
+                                     c & 4 ? g.dims[2] - 0.5 : -0.5);
+            lo = std::min(lo, camera.depth(X));
+            hi = std::max(hi, camera.depth(X));
+        }
+        f1 = (float)lo;
+        f2 = (float)hi;
+    }
+    for (const Point& p : missing)
+        if (state.at<uchar>(p) == 2)
+        {
+            d1.at<float>(p) = f1;
+            d2.at<float>(p) = f2;
+        }
+
+    // Patch voxels: several rays per pixel, each segment [d1, d2] sampled finely enough that no
+    // voxel it crosses is skipped; a candidate is kept only when its footprint stays in `keep`
+    // (the carving rule), so patches never cover a pixel outside the silhouette.
+    CarveView view;
+    view.proj = proj;
+    view.pad = 4;
+    view.keep = paddedKeep(keep, view.pad);
+    Mat covered = zmin.clone();
+    std::vector<Point> todo = missing;
+    std::vector<uint32_t> accepted;
+    for (int round = 0; round <= kPatchExtraRounds && !todo.empty(); round++)
+    {
+        const int n = raysPerPixel + round;
+        const double widen = g.h * round;
+        std::vector<uint32_t> cand;
+        for (const Point& p : todo)
+        {
+            const double z1 = d1.at<float>(p) - widen, z2 = d2.at<float>(p) + widen;
+            for (int sy = 0; sy < n; sy++)
+                for (int sx = 0; sx < n; sx++)
+                {
+                    const Point2d px(p.x + (sx + 0.5) / n - 0.5, p.y + (sy + 0.5) / n - 0.5);
+                    const Vec3d a = g.toVoxel(camera.unproject(px, z1));
+                    const Vec3d b = g.toVoxel(camera.unproject(px, z2));
+                    const double len = std::max(std::abs(b[0] - a[0]),
+                                                std::max(std::abs(b[1] - a[1]), std::abs(b[2] - a[2])));
+                    const int steps = (int)std::ceil(len * kSamplesPerVoxel);
+                    for (int s = 0; s <= steps; s++)
+                    {
+                        const double t = steps > 0 ? (double)s / steps : 0.0;
+                        const Vec3d v = a + t * (b - a);
+                        const int i = cvRound(v[0]), j = cvRound(v[1]), k = cvRound(v[2]);
+                        if (g.inside(i, j, k) && !g.data[g.index(i, j, k)])
+                            cand.push_back(packVoxel(i, j, k));
+                    }
+                }
+        }
+        std::sort(cand.begin(), cand.end());
+        cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+        std::vector<uint32_t> ok;
+        for (uint32_t c : cand)
+        {
+            if (std::binary_search(accepted.begin(), accepted.end(), c))
+                continue;
+            int i, j, k;
+            unpackVoxel(c, i, j, k);
+            if (g.footprintKept(view, i, j, k))
+                ok.push_back(c);
+        }
+        splatVoxels(proj, ok.data(), nullptr, ok.size(), false, covered, nullptr);
+        std::vector<uint32_t> merged(accepted.size() + ok.size());
+        std::merge(accepted.begin(), accepted.end(), ok.begin(), ok.end(), merged.begin());
+        accepted.swap(merged);
+        std::vector<Point> left;
+        for (const Point& p : todo)
+            if (!(covered.at<float>(p) < std::numeric_limits<float>::infinity()))
+                left.push_back(p);
+        todo.swap(left);
+    }
+    if (!todo.empty())
+    {
+        CV_LOG_DEBUG(NULL, cv::format("augocc: %s: %d silhouette pixels left uncovered by patches",
+                                      obj.name.c_str(), (int)todo.size()));
+    }
+    return accepted;
+}
+
+// ---------------------------------------------------------------------------------------------
+// CloneSetImpl
+
+const ObjectClone& CloneSetImpl::get(const String& object) const
+{
+    auto it = objects.find(object);
+    if (it == objects.end())
+        CV_Error(Error::StsObjectNotFound, "clones: no object '" + object + "'");
+    return it->second;
+}
+
+ObjectClone& CloneSetImpl::get(const String& object)
+{
+    auto it = objects.find(object);
+    if (it == objects.end())
+        CV_Error(Error::StsObjectNotFound, "clones: no object '" + object + "'");
+    return it->second;
+}
+
+std::vector<String> CloneSetImpl::objectNames() const
+{
+    std::vector<String> names;
+    for (const auto& o : objects)
+        names.push_back(o.first);
+    return names;
+}
+
+std::vector<int> CloneSetImpl::keyFrames(const String& object) const
+{
+    std::vector<int> k;
+    for (const auto& m : get(object).masks)
+        k.push_back(m.first);
+    return k;
+}
+
+std::vector<int> CloneSetImpl::patchFrames(const String& object, int frame) const
+{
+    const std::vector<int> keys = keyFrames(object);
+    if (keys.empty())
+        return keys;
+    auto it = std::lower_bound(keys.begin(), keys.end(), frame);
+    if (it != keys.end() && *it == frame)
+        return std::vector<int>(1, frame);
+    if (it == keys.begin())
+        return std::vector<int>(1, keys.front());
+    if (it == keys.end())
+        return std::vector<int>(1, keys.back());
+    const int before = *(it - 1), after = *it;
+    if (patchRule == CloneBuilder::PATCH_BRACKETING)
+        return std::vector<int>{before, after};
+    return std::vector<int>(1, frame - before <= after - frame ? before : after);
+}
+
+int CloneSetImpl::voxelCount(const String& object) const
+{
+    return (int)get(object).grid.count();
+}
+
+int CloneSetImpl::patchVoxelCount(const String& object, int keyFrame) const
+{
+    const ObjectClone& o = get(object);
+    auto it = o.patches.find(keyFrame);
+    return it == o.patches.end() ? 0 : (int)it->second.size();
+}
+
+Vec3i CloneSetImpl::gridSize(const String& object) const
+{
+    return get(object).grid.dims;
+}
+
+double CloneSetImpl::voxelSize(const String& object) const
+{
+    return get(object).grid.h;
+}
+
+void CloneSetImpl::gridPose(const String& object, Matx33d& Rbox, Vec3d& origin) const
+{
+    const ObjectClone& o = get(object);
+    Rbox = o.grid.Rbox;
+    origin = o.grid.origin;
+}
+
+void CloneSetImpl::render(const String& object, int frame, const Camera& camera, Size imageSize,
+                          OutputArray matte, OutputArray depth) const
+{
+    const ObjectClone& o = get(object);
+    if (imageSize.width <= 0 || imageSize.height <= 0)
+        CV_Error(Error::StsBadSize, cv::format("clones: render: bad image size %dx%d",
+                                               imageSize.width, imageSize.height));
+    const VoxelProjector proj = o.grid.projector(camera, imageSize);
+    Mat zmin(imageSize, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+    splatVoxels(proj, o.surface.ijk.data(), o.surface.faces.data(), o.surface.size(), true, zmin,
+                nullptr);
+    for (int kf : patchFrames(object, frame))
+    {
+        auto it = o.patches.find(kf);
+        if (it != o.patches.end())
+            splatVoxels(proj, it->second.data(), nullptr, it->second.size(), false, zmin, nullptr);
+    }
+    if (matte.needed())
+    {
+        Mat m = zmin < std::numeric_limits<float>::infinity();
+        m.copyTo(matte);
+    }
+    if (depth.needed())
+        zmin.copyTo(depth);
+}
+
+void CloneSetImpl::save(const String& path) const
+{
+    writeAtomically(path, [&](const String& tmp) {
+        FileStorage fs(tmp, FileStorage::WRITE | FileStorage::BASE64);
+        if (!fs.isOpened())
+            CV_Error(Error::StsError, path + ": cannot open for writing");
+        fs << "format" << "augocc_clones";
+        fs << "version" << 1;
+        fs << "patch_rule" << (patchRule == CloneBuilder::PATCH_BRACKETING ? "bracketing"
+                                                                              : "nearest");
+        fs << "objects" << "[";
+        for (const auto& it : objects)
+        {
+            const ObjectClone& o = it.second;
+            fs << "{";
+            fs << "name" << o.name;
+            fs << "dims" << Mat(o.grid.dims).reshape(1, 1);
+            fs << "R_box" << Mat(o.grid.Rbox);
+            fs << "origin" << Mat(o.grid.origin);
+            fs << "voxel_size" << o.grid.h;
+            fs << "centre" << Mat(o.centre);
+            fs << "runs" << o.grid.encodeRuns();
+            fs << "key_frames" << "[";
+            for (const auto& m : o.masks)
+            {
+                fs << "{";
+                fs << "frame" << m.first;
+                std::vector<uchar> png;
+                cv::imencode(".png", m.second, png);
+                fs << "mask_png" << Mat(png, true);
+                auto p = o.patches.find(m.first);
+                Mat pv;
+                if (p != o.patches.end() && !p->second.empty())
+                    pv = Mat((int)p->second.size(), 1, CV_32S, (void*)p->second.data()).clone();
+                else
+                    pv = Mat(0, 1, CV_32S);
+                fs << "patches" << pv;
+                fs << "}";
+            }
+            fs << "]";
+            fs << "}";
+        }
+        fs << "]";
+        fs.release();
+    });
+}
+
+void CloneSetImpl::exportPly(const String& dir) const
+{
+    std::error_code ec;
+    fsys::create_directories(dir, ec);
+    if (!fsys::is_directory(dir))
+        CV_Error(Error::StsError, dir + ": cannot create folder");
+    for (const auto& it : objects)
+    {
+        const ObjectClone& o = it.second;
+        writeMeshPly((fsys::path(dir) / (o.name + "_clone.ply")).string(),
+                     o.grid.surfaceMesh(o.surface));
+        for (const auto& p : o.patches)
+            writeMeshPly((fsys::path(dir) / cv::format("%s_patches_%04d.ply", o.name.c_str(),
+                                                       p.first)).string(),
+                         o.grid.cubesMesh(p.second));
+    }
+}
+
+} // namespace detail
+
+Ptr<CloneSet> CloneSet::load(const String& path)
+{
+    using namespace detail;
+    FileStorage fs;
+    try
+    {
+        fs.open(path, FileStorage::READ);
+    }
+    catch (const cv::Exception& e)
+    {
+        CV_Error(Error::StsParseError, path + ": cannot parse: " + e.msg);
+    }
+    if (!fs.isOpened())
+        CV_Error(Error::StsObjectNotFound, path + ": cannot open clones file");
+    if ((String)fs["format"] != "augocc_clones")
+        CV_Error(Error::StsParseError, path + ": key 'format' is not 'augocc_clones'");
+    Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
+    const String rule = (String)fs["patch_rule"];
+    set->patchRule = rule == "bracketing" ? CloneBuilder::PATCH_BRACKETING
+                                          : CloneBuilder::PATCH_NEAREST;
+    FileNode objs = fs["objects"];
+    if (!objs.isSeq())
+        CV_Error(Error::StsParseError, path + ": key 'objects' must be a sequence");
+    for (FileNodeIterator it = objs.begin(); it != objs.end(); ++it)
+    {
+        FileNode n = *it;
+        ObjectClone o;
+        n["name"] >> o.name;
+        const String where = path + ": object '" + o.name + "'";
+        if (o.name.empty())
+            CV_Error(Error::StsParseError, path + ": an object has no 'name'");
+        Mat dims, R, origin, centre, runs;
+        n["dims"] >> dims;
+        n["R_box"] >> R;
+        n["origin"] >> origin;
+        n["centre"] >> centre;
+        n["runs"] >> runs;
+        double h = 0;
+        n["voxel_size"] >> h;
+        if (dims.total() != 3 || R.rows != 3 || R.cols != 3 || origin.total() != 3 ||
+            centre.total() != 3 || runs.empty() || !(h > 0))
+            CV_Error(Error::StsParseError, where + ": missing or malformed dims, R_box, origin, "
+                     "centre, voxel_size or runs");
+        dims.convertTo(dims, CV_32S);
+        R.convertTo(R, CV_64F);
+        origin.convertTo(origin, CV_64F);
+        centre.convertTo(centre, CV_64F);
+        const Vec3i d(dims.ptr<int>()[0], dims.ptr<int>()[1], dims.ptr<int>()[2]);
+        if (d[0] <= 0 || d[1] <= 0 || d[2] <= 0 || std::max(d[0], std::max(d[1], d[2])) > kMaxGridDim)
+            CV_Error(Error::StsParseError, where + ": bad grid dims");
+        o.grid.dims = d;
+        o.grid.Rbox = Matx33d((double*)R.ptr<double>());
+        o.grid.origin = Vec3d(origin.ptr<double>());
+        o.grid.h = h;
+        o.centre = Vec3d(centre.ptr<double>());
+        o.grid.decodeRuns(runs, where);
+        FileNode kfs = n["key_frames"];
+        for (FileNodeIterator k = kfs.begin(); k != kfs.end(); ++k)
+        {
+            int frame = -1;
+            (*k)["frame"] >> frame;
+            Mat png, pv;
+            (*k)["mask_png"] >> png;
+            (*k)["patches"] >> pv;
+            Mat mask = png.empty() ? Mat() : cv::imdecode(png, IMREAD_GRAYSCALE);
+            if (frame < 0 || mask.empty())
+                CV_Error(Error::StsParseError, where + ": a key frame has no frame or mask");
+            o.masks[frame] = mask;
+            std::vector<uint32_t> p;
+            if (!pv.empty())
+            {
+                if (pv.type() != CV_32SC1)
+                    CV_Error(Error::StsParseError, where + ": patches must be CV_32S");
+                const uint32_t* q = (const uint32_t*)pv.ptr<int>();
+                p.assign(q, q + pv.total());
+                for (uint32_t v : p)
+                {
+                    int i, j, kk;
+                    unpackVoxel(v, i, j, kk);
+                    if (!o.grid.inside(i, j, kk))
+                        CV_Error(Error::StsParseError, where + ": a patch voxel is off the grid");
+                }
+            }
+            o.patches[frame] = p;
+        }
+        o.surface = o.grid.surface();
+        set->objects[o.name] = std::move(o);
+    }
+    return set;
+}
+
+void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks& mattes,
+                  std::map<String, std::map<int, Mat> >* depth)
+{
+    const std::vector<String> names = clones.objectNames();
+    const int nc = (int)rec.cameras.size();
+    if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
+        CV_Error(Error::StsBadSize, "renderMattes: reconstruction has no image size");
+    std::vector<std::vector<Mat> > m(names.size(), std::vector<Mat>(nc)), d = m;
+    parallel_for_(Range(0, nc), [&](const Range& r) {
+        for (int c = r.start; c < r.end; c++)
+            for (size_t o = 0; o < names.size(); o++)
+            {
+                if (depth)
+                    clones.render(names[o], rec.cameras[c].frame, rec.cameras[c], rec.imageSize,
+                                  m[o][c], d[o][c]);
+                else
+                    clones.render(names[o], rec.cameras[c].frame, rec.cameras[c], rec.imageSize,
+                                  m[o][c]);
+            }
+    });
+    mattes.clear();
+    if (depth)
+        depth->clear();
+    for (size_t o = 0; o < names.size(); o++)
+        for (int c = 0; c < nc; c++)
+        {
+            mattes[names[o]][rec.cameras[c].frame] = m[o][c];
+            if (depth)
+                (*depth)[names[o]][rec.cameras[c].frame] = d[o][c];
+        }
+}
+
+void writeMattes(const String& dir, const CloneSet& clones, const Reconstruction& rec,
+                 const String& depthDir)
+{
+    ObjectMasks mattes;
+    std::map<String, std::map<int, Mat> > depth;
+    renderMattes(clones, rec, mattes, depthDir.empty() ? nullptr : &depth);
+    if (!depthDir.empty())
+    {
+        namespace fsys = std::filesystem;
+        fsys::path target(depthDir);
+        if (target.has_parent_path())
+            fsys::create_directories(target.parent_path());
+        writeAtomically(depthDir, [&](const String& tmp) {
+            fsys::create_directories(tmp);
+            for (const auto& o : depth)
+            {
+                const fsys::path od = fsys::path(tmp) / o.first;
+                fsys::create_directories(od);
+                for (const auto& f : o.second)
+                {
+                    const String file = (od / cv::format("%04d.tiff", f.first)).string();
+                    if (!cv::imwrite(file, f.second))
+                        CV_Error(Error::StsError, depthDir + ": cannot write " + file);
+                }
+            }
+        });
+    }
+    writeMasks(dir, mattes);
+}
+
+} // namespace augocc
+} // namespace cv

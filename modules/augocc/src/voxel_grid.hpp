@@ -1,0 +1,184 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#ifndef OPENCV_AUGOCC_VOXEL_GRID_HPP
+#define OPENCV_AUGOCC_VOXEL_GRID_HPP
+
+#include <cstdint>
+#include <vector>
+#include <opencv2/core.hpp>
+#include "opencv2/augocc/camera.hpp"
+#include "opencv2/augocc/mesh.hpp"
+
+/*
+The one voxel grid of the module (DESIGN.md): dense, one byte per voxel, a rigid box pose, carving
+against silhouettes, surface extraction, footprint splatting (matte + depth) and run-length I/O.
+
+Voxel (i, j, k) is the cube of edge h centred at origin + Rbox * (h * (i + 0.5, j + 0.5, k + 0.5)).
+Its FOOTPRINT in an image is the set of pixel centres inside the bounding rectangle of its
+projected cube (half extents from the projection's Jacobian at the centre; exact for the
+scaled-orthographic model), plus the pixel its centre rounds to. Carving and rendering use this
+one rule (VoxelProjector::footprint), which is what makes the key-frame mattes exact.
+*/
+
+namespace cv {
+namespace augocc {
+namespace detail {
+
+//! Voxel coordinates (i, j, k) packed in 32 bits, 10 bits each (grids up to 1024 per axis).
+inline uint32_t packVoxel(int i, int j, int k)
+{
+    return (uint32_t)i | ((uint32_t)j << 10) | ((uint32_t)k << 20);
+}
+inline void unpackVoxel(uint32_t p, int& i, int& j, int& k)
+{
+    i = (int)(p & 1023u);
+    j = (int)((p >> 10) & 1023u);
+    k = (int)(p >> 20);
+}
+//! Largest grid dimension that packVoxel() holds.
+const int kMaxGridDim = 1023;
+
+//! Surface voxels: packed coordinates and a 6-bit mask of exposed faces (-x,+x,-y,+y,-z,+z).
+struct SurfaceVoxels
+{
+    std::vector<uint32_t> ijk;
+    std::vector<uchar> faces;
+    size_t size() const { return ijk.size(); }
+};
+
+/** @brief A camera seen from voxel coordinates: homogeneous pixel (u w, v w, w) = M (i,j,k)^T + c
+and camera depth z = Z . (i,j,k) + z0 of a voxel centre. */
+struct VoxelProjector
+{
+    Matx33d M;
+    Vec3d c;
+    Vec3d Z;
+    double z0 = 0;
+    bool affine = true;
+    Size size;
+    Vec3d viewDir;    //!< affine: viewing direction in voxel coordinates
+    Vec3d camVoxel;   //!< perspective: camera centre in voxel coordinates
+    double ruAffine = 0, rvAffine = 0;  //!< affine: footprint half extents in pixels
+
+    /** @brief Footprint of voxel (i, j, k): pixel rectangle [x0, x1] x [y0, y1] (inclusive, not
+    clipped) and the centre's depth. Returns false when the voxel is not in front of the camera. */
+    inline bool footprint(double i, double j, double k, int& x0, int& x1, int& y0, int& y1,
+                          double& depth) const
+    {
+        const double hx = M(0, 0) * i + M(0, 1) * j + M(0, 2) * k + c[0];
+        const double hy = M(1, 0) * i + M(1, 1) * j + M(1, 2) * k + c[1];
+        double u, v, ru, rv;
+        if (affine)
+        {
+            u = hx;
+            v = hy;
+            ru = ruAffine;
+            rv = rvAffine;
+        }
+        else
+        {
+            const double w = M(2, 0) * i + M(2, 1) * j + M(2, 2) * k + c[2];
+            if (!(w > 1e-12))
+                return false;
+            const double iw = 1.0 / w;
+            u = hx * iw;
+            v = hy * iw;
+            ru = 0.5 * iw * (std::abs(M(0, 0) - u * M(2, 0)) + std::abs(M(0, 1) - u * M(2, 1)) +
+                             std::abs(M(0, 2) - u * M(2, 2)));
+            rv = 0.5 * iw * (std::abs(M(1, 0) - v * M(2, 0)) + std::abs(M(1, 1) - v * M(2, 1)) +
+                             std::abs(M(1, 2) - v * M(2, 2)));
+        }
+        const int pu = cvRound(u), pv = cvRound(v);
+        x0 = std::min((int)std::ceil(u - ru), pu);
+        x1 = std::max((int)std::floor(u + ru), pu);
+        y0 = std::min((int)std::ceil(v - rv), pv);
+        y1 = std::max((int)std::floor(v + rv), pv);
+        depth = Z[0] * i + Z[1] * j + Z[2] * k + z0;
+        return true;
+    }
+};
+
+/** @brief One key frame prepared for carving: keep-label image (silhouette or unknown = 255,
+outside = 0) padded by `pad` keep pixels, and the chessboard distance of every pixel to the
+nearest pixel of the other label. */
+struct CarveView
+{
+    VoxelProjector proj;
+    Mat keep;   //!< CV_8U, padded
+    Mat dist;   //!< CV_32F, padded, chessboard distance to the other label
+    int pad = 0;
+};
+
+class CV_EXPORTS VoxelGrid
+{
+public:
+    Vec3i dims = Vec3i(0, 0, 0);
+    Matx33d Rbox = Matx33d::eye();  //!< box axes (columns) in world coordinates
+    Vec3d origin = Vec3d(0, 0, 0);  //!< world position of the grid's corner
+    double h = 1;                   //!< voxel edge, world units
+    std::vector<uchar> data;        //!< 1 = inside, x fastest then y then z
+
+    //! Allocates the grid with every voxel set to `value`.
+    void create(const Vec3i& dims, const Matx33d& Rbox, const Vec3d& origin, double h,
+                uchar value);
+    bool empty() const { return data.empty(); }
+    int64 total() const { return (int64)dims[0] * dims[1] * dims[2]; }
+    size_t index(int i, int j, int k) const
+    {
+        return ((size_t)k * dims[1] + j) * dims[0] + i;
+    }
+    bool inside(int i, int j, int k) const
+    {
+        return i >= 0 && j >= 0 && k >= 0 && i < dims[0] && j < dims[1] && k < dims[2];
+    }
+    //! World position of voxel centre (i, j, k) (fractional indices allowed).
+    Vec3d centre(double i, double j, double k) const
+    {
+        return origin + Rbox * Vec3d(h * (i + 0.5), h * (j + 0.5), h * (k + 0.5));
+    }
+    //! Continuous voxel coordinates of a world point (voxel centres at integers).
+    Vec3d toVoxel(const Vec3d& Xw) const
+    {
+        const Vec3d b = Rbox.t() * (Xw - origin);
+        return Vec3d(b[0] / h - 0.5, b[1] / h - 0.5, b[2] / h - 0.5);
+    }
+    //! Number of voxels inside.
+    int64 count() const;
+
+    //! The camera in voxel coordinates.
+    VoxelProjector projector(const Camera& camera, Size imageSize) const;
+    //! Prepares a key frame: `keep` is CV_8U, nonzero = silhouette or unknown.
+    CarveView carveView(const Camera& camera, const Mat& keep) const;
+    /** @brief Carves every voxel whose footprint holds a pixel labelled outside in any view
+    (pixels off the image are unknown). Parallel over z slices; deterministic. */
+    void carve(const std::vector<CarveView>& views);
+    //! True when voxel (i, j, k)'s footprint lies in the keep region of `view`.
+    bool footprintKept(const CarveView& view, int i, int j, int k) const;
+
+    //! Voxels inside with at least one face on a voxel outside (or on the grid's border).
+    SurfaceVoxels surface() const;
+
+    //! Run lengths of the flattened grid, alternating 0-runs and 1-runs, starting with 0 (CV_32S).
+    Mat encodeRuns() const;
+    //! Inverse of encodeRuns(); `dims` must be set. Throws StsParseError on inconsistent runs.
+    void decodeRuns(const Mat& runs, const String& what);
+
+    //! Exposed faces of the surface as a mesh in world coordinates (two triangles per face).
+    Mesh surfaceMesh(const SurfaceVoxels& s) const;
+    //! Cubes of a list of voxels as a mesh in world coordinates.
+    Mesh cubesMesh(const std::vector<uint32_t>& voxels) const;
+};
+
+/** @brief Splats voxel footprints: zmin (CV_32F, +inf initialised by the caller) takes the nearest
+centre depth; zmax (optional) the farthest. With `frontOnly`, voxels with no exposed face turned
+to the camera are skipped (they cannot change the footprint union). `faces` may be null (every
+voxel drawn). */
+CV_EXPORTS void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, size_t n,
+                 bool frontOnly, Mat& zmin, Mat* zmax);
+
+} // namespace detail
+} // namespace augocc
+} // namespace cv
+
+#endif

@@ -1,0 +1,468 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#include "test_precomp.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace opencv_test {
+namespace {
+
+using namespace cv;
+using namespace cv::augocc;
+
+// ---------------------------------------------------------------------------------------------
+// Analytic scenes: objects made of axis-aligned boxes (y up), silhouettes sampled exactly at
+// pixel centres from the convex hull of each box's projected corners.
+
+struct AnalyticObject
+{
+    String name;
+    std::vector<std::pair<Vec3d, Vec3d> > boxes;
+};
+
+struct AnalyticScene
+{
+    Reconstruction rec;
+    std::vector<AnalyticObject> objects;
+    ObjectMasks whole;       // every frame
+    ObjectMasks visible;     // every frame (objects listed front to back)
+    ObjectMasks keyMasks;    // visible silhouettes in the key frames
+    std::vector<int> keyFrames;
+};
+
+Camera orbitCamera(CameraModel model, double azimuthDeg, double elevationDeg, double dist,
+                   const Vec3d& target, Size size, double pixelsPerUnit, int frame)
+{
+    const double a = azimuthDeg * CV_PI / 180, e = elevationDeg * CV_PI / 180;
+    const Vec3d C = target + Vec3d(dist * std::cos(e) * std::sin(a), dist * std::sin(e),
+                                   dist * std::cos(e) * std::cos(a));
+    Vec3d f = target - C;
+    f /= cv::norm(f);
+    Vec3d x = f.cross(Vec3d(0, 1, 0));
+    x /= cv::norm(x);
+    const Vec3d y = f.cross(x);
+    const Matx33d R(x[0], x[1], x[2], y[0], y[1], y[2], f[0], f[1], f[2]);
+    const Vec3d t = -(R * C);
+    const Point2d pp(size.width / 2.0 - 0.5, size.height / 2.0 - 0.5);
+    if (model == SCALED_ORTHOGRAPHIC)
+        return Camera::orthographic(R, t, pixelsPerUnit, pp, frame);
+    const double fpx = pixelsPerUnit * dist;
+    return Camera::perspective(R, t, Matx33d(fpx, 0, pp.x, 0, fpx, pp.y, 0, 0, 1), frame);
+}
+
+Mat silhouetteOf(const AnalyticObject& o, const Camera& cam, Size size)
+{
+    Mat m(size, CV_8U, Scalar(0));
+    for (const auto& b : o.boxes)
+    {
+        std::vector<Point2f> c, hull;
+        for (int q = 0; q < 8; q++)
+        {
+            const Vec3d X(q & 1 ? b.second[0] : b.first[0], q & 2 ? b.second[1] : b.first[1],
+                          q & 4 ? b.second[2] : b.first[2]);
+            const Point2d uv = cam.project(X);
+            c.push_back(Point2f((float)uv.x, (float)uv.y));
+        }
+        convexHull(c, hull);
+        const Rect r = boundingRect(hull) & Rect(Point(0, 0), size);
+        for (int y = r.y; y < r.y + r.height; y++)
+            for (int x = r.x; x < r.x + r.width; x++)
+                if (pointPolygonTest(hull, Point2f((float)x, (float)y), false) >= 0)
+                    m.at<uchar>(y, x) = 255;
+    }
+    return m;
+}
+
+AnalyticScene makeScene(CameraModel model, const std::vector<AnalyticObject>& objects, int frames,
+                        int numKeys, double orbitDeg = 50, Size size = Size(640, 480))
+{
+    AnalyticScene s;
+    s.objects = objects;
+    s.rec.model = model;
+    s.rec.imageSize = size;
+    const Vec3d target(1.5, 1.0, 0.0);
+    for (int f = 0; f < frames; f++)
+    {
+        const double az = -orbitDeg / 2 + orbitDeg * f / (frames - 1);
+        s.rec.cameras.push_back(orbitCamera(model, az, 25, 40, target, size, 45, f));
+    }
+    for (int k = 0; k < numKeys; k++)
+        s.keyFrames.push_back(cvRound((double)k * (frames - 1) / (numKeys - 1)));
+    RNG rng(11);
+    std::vector<Vec3d> pts;
+    for (int f = 0; f < frames; f++)
+    {
+        Mat covered(size, CV_8U, Scalar(0));
+        for (const AnalyticObject& o : objects)
+        {
+            const Mat w = silhouetteOf(o, s.rec.cameras[f], size);
+            s.whole[o.name][f] = w;
+            s.visible[o.name][f] = w & ~covered;
+            covered |= w;
+        }
+    }
+    for (int k : s.keyFrames)
+        for (const AnalyticObject& o : objects)
+            s.keyMasks[o.name][k] = s.visible[o.name][k];
+    // Points on the objects' faces, plus ground points.
+    for (const AnalyticObject& o : objects)
+        for (const auto& b : o.boxes)
+            for (int q = 0; q < 60; q++)
+            {
+                Vec3d X(rng.uniform(b.first[0], b.second[0]), rng.uniform(b.first[1], b.second[1]),
+                        rng.uniform(b.first[2], b.second[2]));
+                const int axis = rng.uniform(0, 3);
+                X[axis] = rng.uniform(0, 2) ? b.second[axis] : b.first[axis];
+                pts.push_back(X);
+            }
+    for (int q = 0; q < 80; q++)
+        pts.push_back(Vec3d(rng.uniform(-6.0, 9.0), 0.0, rng.uniform(-6.0, 6.0)));
+    s.rec.points = Mat((int)pts.size(), 3, CV_64F);
+    for (size_t q = 0; q < pts.size(); q++)
+        for (int a = 0; a < 3; a++)
+            s.rec.points.at<double>((int)q, a) = pts[q][a];
+    return s;
+}
+
+std::vector<AnalyticObject> towerAndEll()
+{
+    AnalyticObject tower{"tower", {{Vec3d(-1, 0, -1), Vec3d(1, 3, 1)}}};
+    AnalyticObject ell{"ell", {{Vec3d(2.5, 0, -1), Vec3d(5.5, 1.5, 0)},
+                               {Vec3d(4.5, 0, -1), Vec3d(5.5, 1.5, 2)}}};
+    return {tower, ell};
+}
+
+// front hides part of back in every frame (listed front to back).
+std::vector<AnalyticObject> frontAndBack()
+{
+    AnalyticObject front{"front", {{Vec3d(0.7, 0, 1.5), Vec3d(2.3, 3.0, 3)}}};
+    AnalyticObject back{"back", {{Vec3d(0, 0, -4), Vec3d(3, 3, -2)}}};
+    return {front, back};
+}
+
+// Mean distance (px) from the boundary pixels of `a` to the boundary of `b`.
+double meanBoundaryDistance(const Mat& a, const Mat& b)
+{
+    Mat ea, eb;
+    erode(a, ea, Mat());
+    erode(b, eb, Mat());
+    Mat ba = a & ~ea, bb = b & ~eb;
+    Mat dt;
+    distanceTransform(~bb, dt, DIST_L2, DIST_MASK_PRECISE);
+    std::vector<Point> pts;
+    findNonZero(ba, pts);
+    if (pts.empty())
+        return 0;
+    double s = 0;
+    for (const Point& p : pts)
+        s += dt.at<float>(p);
+    return s / pts.size();
+}
+
+struct Figures
+{
+    double keyMin = 1, nonKeyMean = 0, nonKeyMin = 1, boundaryMean = 0;
+};
+
+Figures measure(const CloneSet& clones, const AnalyticScene& s, const String& object,
+                const ObjectMasks& nonKeyRef)
+{
+    Figures fig;
+    double sumIoU = 0, sumB = 0;
+    int n = 0;
+    for (const Camera& cam : s.rec.cameras)
+    {
+        Mat matte;
+        clones.render(object, cam.frame, cam, s.rec.imageSize, matte);
+        const bool key = std::find(s.keyFrames.begin(), s.keyFrames.end(), cam.frame) !=
+                         s.keyFrames.end();
+        if (key)
+        {
+            // Against the key-frame silhouette, outside the pixels of nearer objects (objects are
+            // listed front to back): there the clone is unknown by design (occlusion-aware
+            // carving) and the nearer object's clone is in front anyway.
+            const Mat& sil = s.keyMasks.at(object).at(cam.frame);
+            Mat nearer(sil.size(), CV_8U, Scalar(0));
+            for (const AnalyticObject& o : s.objects)
+            {
+                if (o.name == object)
+                    break;
+                nearer |= s.keyMasks.at(o.name).at(cam.frame);
+            }
+            fig.keyMin = std::min(fig.keyMin, maskIoU(matte & ~nearer, sil));
+            continue;
+        }
+        const Mat& ref = nonKeyRef.at(object).at(cam.frame);
+        const double iou = maskIoU(matte, ref);
+        sumIoU += iou;
+        sumB += meanBoundaryDistance(matte, ref);
+        fig.nonKeyMin = std::min(fig.nonKeyMin, iou);
+        n++;
+    }
+    fig.nonKeyMean = sumIoU / std::max(n, 1);
+    fig.boundaryMean = sumB / std::max(n, 1);
+    return fig;
+}
+
+// Key frames: the clone plus the frame's patches cover the silhouette exactly (issue 4).
+const double kKeyFrameMinIoU = 0.999;
+// Non-key frames of the analytic two-object scene (6 key frames over 30): the issue's synthetic
+// targets (mean 0.98, worst 0.95, boundary 1 px), which the analytic boxes meet as well.
+const double kNonKeyMeanIoU = 0.98;
+const double kNonKeyMinIoU = 0.95;
+const double kMaxMeanBoundaryPx = 1.0;
+// Occlusion case: the hidden object's clone covers its whole silhouette (issue 4: mean 0.97).
+const double kHiddenMeanIoU = 0.97;
+
+typedef testing::TestWithParam<int> Augocc_CloneBuilder_P;
+
+TEST_P(Augocc_CloneBuilder_P, accuracy)
+{
+    const CameraModel model = (CameraModel)GetParam();
+    const AnalyticScene s = makeScene(model, towerAndEll(), 30, 6);
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    ASSERT_FALSE(clones.empty());
+    EXPECT_EQ(clones->objectNames(), std::vector<String>({"ell", "tower"}));
+    for (const String& name : clones->objectNames())
+    {
+        const Figures f = measure(*clones, s, name, s.whole);
+        std::cout << cameraModelName(model) << " " << name << ": key min IoU " << f.keyMin
+                  << ", non-key mean IoU " << f.nonKeyMean << " min " << f.nonKeyMin
+                  << ", boundary " << f.boundaryMean << " px, voxels " << clones->voxelCount(name)
+                  << " grid " << clones->gridSize(name) << std::endl;
+        EXPECT_GE(f.keyMin, kKeyFrameMinIoU) << name;
+        EXPECT_GE(f.nonKeyMean, kNonKeyMeanIoU) << name;
+        EXPECT_GE(f.nonKeyMin, kNonKeyMinIoU) << name;
+        EXPECT_LE(f.boundaryMean, kMaxMeanBoundaryPx) << name;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(/**/, Augocc_CloneBuilder_P,
+                         testing::Values((int)SCALED_ORTHOGRAPHIC, (int)PERSPECTIVE));
+
+TEST(Augocc_CloneBuilder, can_create_default)
+{
+    Ptr<CloneBuilder> b = CloneBuilder::create();
+    ASSERT_FALSE(b.empty());
+    EXPECT_EQ(b->getParams().orientation, (int)CloneBuilder::ORIENT_AUTO);
+    EXPECT_EQ(b->getParams().voxelPixels, 1.0);
+}
+
+TEST(Augocc_CloneBuilder, bad_arg)
+{
+    CloneBuilder::Params p;
+    p.voxelPixels = 0;
+    EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
+    p = CloneBuilder::Params();
+    p.raysPerPixel = 0;
+    EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
+
+    AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, towerAndEll(), 12, 3);
+    Ptr<CloneBuilder> b = CloneBuilder::create();
+    auto expectError = [&](const ObjectMasks& m, const std::string& needle) {
+        try
+        {
+            b->build(s.rec, m);
+            ADD_FAILURE() << "no exception for " << needle;
+        }
+        catch (const cv::Exception& e)
+        {
+            EXPECT_NE(e.msg.find(needle), std::string::npos) << e.msg;
+        }
+    };
+    ObjectMasks m = s.keyMasks;
+    m["tower"][0] = Mat(s.rec.imageSize, CV_8U, Scalar(0));
+    expectError(m, "empty");
+    m = s.keyMasks;
+    m["tower"][0] = Mat(s.rec.imageSize, CV_8U, Scalar(255));
+    expectError(m, "all white");
+    m = s.keyMasks;
+    m["tower"][99] = s.keyMasks["tower"][0];
+    expectError(m, "no camera");
+    m = s.keyMasks;
+    m["tower"][0] = Mat(100, 100, CV_8U, Scalar(0));
+    expectError(m, "differs");
+    ObjectMasks none;
+    EXPECT_THROW(b->build(s.rec, none), cv::Exception);
+}
+
+// Without any reconstructed point the box comes from the silhouettes alone (documented fallback).
+TEST(Augocc_CloneBuilder, fallback_without_points)
+{
+    AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, towerAndEll(), 30, 6);
+    s.rec.points = Mat();
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    for (const String& name : clones->objectNames())
+    {
+        const Figures f = measure(*clones, s, name, s.whole);
+        EXPECT_GE(f.keyMin, kKeyFrameMinIoU) << name;
+        EXPECT_GE(f.nonKeyMean, kNonKeyMeanIoU) << name;
+    }
+    // One key frame cannot bound an object without points: a clear error.
+    ObjectMasks one;
+    one["tower"][0] = s.keyMasks["tower"][0];
+    EXPECT_THROW(CloneBuilder::create()->build(s.rec, one), cv::Exception);
+}
+
+// A nearer object's silhouette is unknown, not outside: the hidden object keeps its whole shape.
+TEST(Augocc_CloneBuilder, occlusion_aware_carving)
+{
+    const AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, frontAndBack(), 30, 6);
+    Ptr<CloneSet> aware = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    const Figures f = measure(*aware, s, "back", s.whole);
+    std::cout << "hidden object, occlusion-aware: non-key mean IoU vs whole " << f.nonKeyMean
+              << " min " << f.nonKeyMin << ", key min " << f.keyMin << std::endl;
+    EXPECT_GE(f.nonKeyMean, kHiddenMeanIoU);
+    EXPECT_GE(f.keyMin, kKeyFrameMinIoU);
+    CloneBuilder::Params p;
+    p.occlusionAware = false;
+    Ptr<CloneSet> naive = CloneBuilder::create(p)->build(s.rec, s.keyMasks);
+    const Figures g = measure(*naive, s, "back", s.whole);
+    std::cout << "hidden object, paper's carving: non-key mean IoU vs whole " << g.nonKeyMean
+              << std::endl;
+    EXPECT_LT(g.nonKeyMean, f.nonKeyMean);
+}
+
+TEST(Augocc_CloneBuilder, save_load_roundtrip)
+{
+    const AnalyticScene s = makeScene(PERSPECTIVE, towerAndEll(), 12, 3);
+    Ptr<CloneSet> a = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    const std::string dir = tempDir("clone_io");
+    const std::string path = dir + "/clones.yml.gz";
+    a->save(path);
+    Ptr<CloneSet> b = CloneSet::load(path);
+    ASSERT_EQ(a->objectNames(), b->objectNames());
+    for (const String& name : a->objectNames())
+    {
+        EXPECT_EQ(a->voxelCount(name), b->voxelCount(name));
+        EXPECT_EQ(a->keyFrames(name), b->keyFrames(name));
+        for (int f : {0, 5, 11})
+        {
+            Mat ma, mb, da, db;
+            a->render(name, f, s.rec.cameras[f], s.rec.imageSize, ma, da);
+            b->render(name, f, s.rec.cameras[f], s.rec.imageSize, mb, db);
+            EXPECT_EQ(countNonZero(ma != mb), 0);
+            Mat fin = da < 1e30f;
+            EXPECT_LE(cv::norm(da, db, NORM_INF, fin), 0.0);
+        }
+    }
+    a->exportPly(dir + "/ply");
+    EXPECT_TRUE(std::filesystem::exists(dir + "/ply/tower_clone.ply"));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/ply/tower_patches_0000.ply"));
+    // Corrupt and missing files: errors that name the file.
+    {
+        std::ofstream(dir + "/bad.yml") << "%YAML:1.0\nformat: something_else\n";
+    }
+    EXPECT_THROW(CloneSet::load(dir + "/bad.yml"), cv::Exception);
+    EXPECT_THROW(CloneSet::load(dir + "/missing.yml.gz"), cv::Exception);
+    std::filesystem::remove_all(dir);
+}
+
+TEST(Augocc_CloneBuilder, add_key_frame)
+{
+    AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, towerAndEll(), 30, 3);
+    Ptr<CloneBuilder> b = CloneBuilder::create();
+    Ptr<CloneSet> clones = b->build(s.rec, s.keyMasks);
+    const int before = clones->voxelCount("ell");
+    const int f = 7;
+    const Mat mask = s.visible["ell"][f];
+    b->addKeyFrame(*clones, s.rec, "ell", f, mask);
+    EXPECT_LE(clones->voxelCount("ell"), before);
+    std::vector<int> keys = s.keyFrames;
+    keys.push_back(f);
+    std::sort(keys.begin(), keys.end());
+    EXPECT_EQ(clones->keyFrames("ell"), keys);
+    EXPECT_EQ(clones->patchFrames("ell", f), std::vector<int>(1, f));
+    Mat matte;
+    clones->render("ell", f, s.rec.cameras[f], s.rec.imageSize, matte);
+    EXPECT_GE(maskIoU(matte, mask), kKeyFrameMinIoU);
+    EXPECT_THROW(b->addKeyFrame(*clones, s.rec, "nobody", f, mask), cv::Exception);
+    EXPECT_THROW(b->addKeyFrame(*clones, s.rec, "ell", 1000, mask), cv::Exception);
+}
+
+TEST(Augocc_CloneBuilder, auto_orientation_fits_rotated_box)
+{
+    // A box turned 30 degrees about the vertical: the automatic orientation finds its facades.
+    const double th = 30 * CV_PI / 180;
+    const Matx33d Ry(std::cos(th), 0, std::sin(th), 0, 1, 0, -std::sin(th), 0, std::cos(th));
+    const AnalyticScene s0 = makeScene(SCALED_ORTHOGRAPHIC, {{"b", {{Vec3d(-1.5, 0, -0.6),
+                                       Vec3d(1.5, 2, 0.6)}}}}, 20, 4);
+    // Rotate the world: cameras and points (same images).
+    AnalyticScene s = s0;
+    for (Camera& c : s.rec.cameras)
+        c.R = c.R * Ry.t();
+    for (int p = 0; p < s.rec.points.rows; p++)
+    {
+        const Vec3d X = Ry * Vec3d(s.rec.points.ptr<double>(p));
+        for (int a = 0; a < 3; a++)
+            s.rec.points.at<double>(p, a) = X[a];
+    }
+    Ptr<CloneSet> autoSet = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    Matx33d Rb;
+    Vec3d o;
+    autoSet->gridPose("b", Rb, o);
+    // Box axes vs the true facades (up to axis permutation and sign): within 2 degrees.
+    const Matx33d D = Ry.t() * Rb;
+    double worst = 0;
+    for (int c = 0; c < 3; c++)
+    {
+        double best = 0;
+        for (int r = 0; r < 3; r++)
+            best = std::max(best, std::abs(D(r, c)));
+        worst = std::max(worst, std::acos(std::min(1.0, best)) * 180 / CV_PI);
+    }
+    EXPECT_LE(worst, 2.0);
+    CloneBuilder::Params p;
+    p.orientation = CloneBuilder::ORIENT_WORLD;
+    Ptr<CloneSet> worldSet = CloneBuilder::create(p)->build(s.rec, s.keyMasks);
+    const Vec3i ga = autoSet->gridSize("b"), gw = worldSet->gridSize("b");
+    EXPECT_LT((double)ga[0] * ga[1] * ga[2], 0.8 * gw[0] * gw[1] * gw[2]);
+    const Figures f = measure(*autoSet, s, "b", s.whole);
+    EXPECT_GE(f.nonKeyMean, kNonKeyMeanIoU);
+}
+
+TEST(Augocc_CloneBuilder, multithread_reproducibility)
+{
+    const AnalyticScene s = makeScene(PERSPECTIVE, towerAndEll(), 12, 4);
+    const int threads = getNumThreads();
+    setNumThreads(1);
+    Ptr<CloneSet> a = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    setNumThreads(std::max(threads, 4));
+    Ptr<CloneSet> b = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    setNumThreads(threads);
+    for (const String& name : a->objectNames())
+    {
+        EXPECT_EQ(a->voxelCount(name), b->voxelCount(name));
+        for (int k : a->keyFrames(name))
+            EXPECT_EQ(a->patchVoxelCount(name, k), b->patchVoxelCount(name, k));
+        ObjectMasks ma, mb;
+        renderMattes(*a, s.rec, ma);
+        renderMattes(*b, s.rec, mb);
+        for (const auto& fm : ma[name])
+            EXPECT_EQ(countNonZero(fm.second != mb[name][fm.first]), 0);
+    }
+}
+
+TEST(Augocc_CloneBuilder, write_mattes_folder)
+{
+    const AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, towerAndEll(), 8, 3);
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    const std::string dir = tempDir("clone_mattes");
+    writeMattes(dir + "/mattes", *clones, s.rec, dir + "/depth");
+    const ObjectMasks m = readMasks(dir + "/mattes", s.rec.imageSize);
+    ASSERT_EQ(m.size(), 2u);
+    EXPECT_EQ(m.at("tower").size(), 8u);
+    Mat ref;
+    clones->render("tower", 3, s.rec.cameras[3], s.rec.imageSize, ref);
+    EXPECT_EQ(countNonZero(ref != m.at("tower").at(3)), 0);
+    const Mat d = imread(dir + "/depth/tower/0003.tiff", IMREAD_UNCHANGED);
+    ASSERT_EQ(d.type(), CV_32FC1);
+    EXPECT_EQ(countNonZero(d < 1e30f), countNonZero(ref));
+    std::filesystem::remove_all(dir);
+}
+
+} // namespace
+} // namespace opencv_test

@@ -1,0 +1,146 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#include "test_precomp.hpp"
+#include "voxel_grid.hpp"
+
+namespace opencv_test {
+namespace {
+
+using namespace cv;
+using namespace cv::augocc;
+using namespace cv::augocc::detail;
+
+Camera lookAtCamera(CameraModel model, double azimuthDeg, double elevationDeg, double dist,
+                    Size size, double pixelsPerUnit)
+{
+    const double a = azimuthDeg * CV_PI / 180, e = elevationDeg * CV_PI / 180;
+    const Vec3d C(dist * std::cos(e) * std::sin(a), dist * std::sin(e), dist * std::cos(e) * std::cos(a));
+    const Vec3d f = -C / cv::norm(C);
+    Vec3d x = f.cross(Vec3d(0, 1, 0));
+    x /= cv::norm(x);
+    const Vec3d y = f.cross(x);
+    const Matx33d R(x[0], x[1], x[2], y[0], y[1], y[2], f[0], f[1], f[2]);
+    const Vec3d t = -(R * C);
+    const Point2d pp(size.width / 2.0 - 0.5, size.height / 2.0 - 0.5);
+    if (model == SCALED_ORTHOGRAPHIC)
+        return Camera::orthographic(R, t, pixelsPerUnit, pp);
+    const double fpx = pixelsPerUnit * dist;
+    return Camera::perspective(R, t, Matx33d(fpx, 0, pp.x, 0, fpx, pp.y, 0, 0, 1));
+}
+
+Mat blobMask(Size size, RNG& rng)
+{
+    Mat m(size, CV_8U, Scalar(0));
+    for (int q = 0; q < 6; q++)
+        circle(m, Point(size.width / 2 + rng.uniform(-60, 60), size.height / 2 + rng.uniform(-60, 60)),
+               rng.uniform(20, 70), Scalar(255), FILLED);
+    return m;
+}
+
+typedef testing::TestWithParam<int> Augocc_VoxelGrid_P;
+
+// The row walk skips voxels by distance bounds: its result must equal the plain per-voxel test.
+TEST_P(Augocc_VoxelGrid_P, carve_equals_brute_force)
+{
+    const CameraModel model = (CameraModel)GetParam();
+    RNG rng(7);
+    const Size size(320, 240);
+    VoxelGrid g;
+    const Matx33d Rb = rotationFromRodrigues(Vec3d(0.1, 0.5, -0.2));
+    g.create(Vec3i(70, 60, 50), Rb, Rb * Vec3d(-2.2, -2.0, -1.6), 0.065, 1);
+    std::vector<CarveView> views;
+    std::vector<Camera> cams;
+    for (int v = 0; v < 3; v++)
+    {
+        cams.push_back(lookAtCamera(model, 40.0 * v - 30, 20, 30, size, 40));
+        views.push_back(g.carveView(cams.back(), blobMask(size, rng)));
+    }
+    VoxelGrid fast = g;
+    fast.carve(views);
+    int64 mismatches = 0, kept = 0;
+    for (int k = 0; k < g.dims[2]; k++)
+        for (int j = 0; j < g.dims[1]; j++)
+            for (int i = 0; i < g.dims[0]; i++)
+            {
+                bool keep = true;
+                for (const CarveView& v : views)
+                    keep = keep && g.footprintKept(v, i, j, k);
+                kept += keep;
+                mismatches += keep != (fast.data[fast.index(i, j, k)] != 0);
+            }
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_GT(kept, 1000);
+    EXPECT_LT(kept, g.total());
+}
+
+INSTANTIATE_TEST_SUITE_P(/**/, Augocc_VoxelGrid_P, testing::Values((int)SCALED_ORTHOGRAPHIC,
+                                                                    (int)PERSPECTIVE));
+
+TEST(Augocc_VoxelGrid, runs_roundtrip_and_surface)
+{
+    VoxelGrid g;
+    g.create(Vec3i(20, 30, 40), Matx33d::eye(), Vec3d(0, 0, 0), 0.1, 0);
+    RNG rng(3);
+    for (int k = 5; k < 35; k++)
+        for (int j = 4; j < 26; j++)
+            for (int i = 2; i < 18; i++)
+                g.data[g.index(i, j, k)] = rng.uniform(0, 10) > 0 ? 1 : 0;
+    const Mat runs = g.encodeRuns();
+    VoxelGrid h = g;
+    h.data.assign(h.data.size(), 0);
+    h.decodeRuns(runs, "test");
+    EXPECT_TRUE(h.data == g.data);
+    Mat bad = runs.clone();
+    bad.at<int>(0) += 1;
+    EXPECT_THROW(h.decodeRuns(bad, "test"), cv::Exception);
+
+    // A solid block's surface: all voxels but the interior ones.
+    VoxelGrid b;
+    b.create(Vec3i(10, 12, 14), Matx33d::eye(), Vec3d(0, 0, 0), 1.0, 1);
+    EXPECT_EQ((int64)b.surface().size(), b.total() - (int64)8 * 10 * 12);
+}
+
+// A solid block's matte is its projected outline (hole-free) whatever the view.
+TEST(Augocc_VoxelGrid, splat_is_hole_free)
+{
+    const Size size(320, 240);
+    for (int model = 0; model < 2; model++)
+        for (double az : {0.0, 33.0, 71.0})
+        {
+            const Camera cam = lookAtCamera((CameraModel)model, az, 25, 30, size, 40);
+            VoxelGrid g;
+            g.create(Vec3i(80, 60, 70), Matx33d::eye(), Vec3d(-1.6, -1.2, -1.4), 0.04, 1);
+            const SurfaceVoxels s = g.surface();
+            const VoxelProjector p = g.projector(cam, size);
+            Mat z(size, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+            splatVoxels(p, s.ijk.data(), s.faces.data(), s.size(), true, z, nullptr);
+            Mat matte = z < std::numeric_limits<float>::infinity();
+            // Reference: convex hull of the block's 8 corners, sampled at pixel centres.
+            std::vector<Point2f> c;
+            for (int q = 0; q < 8; q++)
+            {
+                const Point2d uv = cam.project(g.centre(q & 1 ? 79.5 : -0.5, q & 2 ? 59.5 : -0.5,
+                                                        q & 4 ? 69.5 : -0.5));
+                c.push_back(Point2f((float)uv.x, (float)uv.y));
+            }
+            std::vector<Point2f> hull;
+            convexHull(c, hull);
+            Mat ref(size, CV_8U, Scalar(0));
+            for (int y = 0; y < size.height; y++)
+                for (int x = 0; x < size.width; x++)
+                    if (pointPolygonTest(hull, Point2f((float)x, (float)y), false) >= 0)
+                        ref.at<uchar>(y, x) = 255;
+            // Footprints are pixel-centre rectangles around each voxel: at most one pixel more
+            // than the exact outline on the border, never a hole inside.
+            Mat inner;
+            erode(ref, inner, Mat());
+            EXPECT_EQ(countNonZero(inner & ~matte), 0) << "model " << model << " az " << az;
+            Mat outer;
+            dilate(ref, outer, Mat());
+            EXPECT_EQ(countNonZero(matte & ~outer), 0) << "model " << model << " az " << az;
+        }
+}
+
+} // namespace
+} // namespace opencv_test
