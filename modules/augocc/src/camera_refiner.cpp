@@ -531,6 +531,7 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
     if (options.bundleAdjust)
     {
         rp.mode = OrthoCameraRefiner::FULL_BA;
+        rp.perFrameScale = options.perFrameScale;
         if (!OrthoCameraRefiner::create(rp)->refine(tracks, rec))
             CV_Error(Error::StsError, "sfm: the scaled-orthographic bundle adjustment failed "
                      "(see the log)");

@@ -108,6 +108,10 @@ struct CV_EXPORTS SfmOptions
     clear drop of the error is what tells that perspective effects are present). */
     String model = "auto";
     bool bundleAdjust = true;      //!< run the full scaled-orthographic BA after the 3F+1
+    /** The scaled-orthographic BA estimates one zoom per frame (weak perspective: the scale of
+    the image changes as the camera moves closer or farther); false keeps the paper's single
+    zoom. Overrides refiner.perFrameScale. */
+    bool perFrameScale = true;
     double autoRatio = 0.9;        //!< `auto`: the RMS ratio below which perspective is kept
     FactorizationSfM::Params factorization;
     OrthoCameraRefiner::Params refiner;  //!< loss and iteration settings shared by the stages
