@@ -23,10 +23,36 @@ namespace fsys = std::filesystem;
 namespace {
 
 // Step 5: extra rounds of candidate patch voxels for pixels the first round left uncovered, each
-// with one more ray per pixel along each axis and the depth range widened by one voxel.
+// with one more ray per pixel along each axis and the depth range widened by one voxel; the last
+// round samples the rays' whole span in the grid.
 const int kPatchExtraRounds = 2;
 // Samples along a ray segment per voxel edge (two: no voxel the segment crosses is skipped).
 const double kSamplesPerVoxel = 2.0;
+
+// Parameters [t0, t1] of the line a + t (b - a) inside the grid's box (voxel coordinates, centres
+// at integers, so the box is [-0.5, dims - 0.5]); false when the line misses it.
+bool clipToGrid(const VoxelGrid& g, const Vec3d& a, const Vec3d& b, double& t0, double& t1)
+{
+    t0 = -std::numeric_limits<double>::infinity();
+    t1 = std::numeric_limits<double>::infinity();
+    const Vec3d d = b - a;
+    for (int ax = 0; ax < 3; ax++)
+    {
+        const double lo = -0.5, hi = g.dims[ax] - 0.5;
+        if (std::abs(d[ax]) < 1e-12)
+        {
+            if (a[ax] < lo || a[ax] > hi)
+                return false;
+            continue;
+        }
+        double ta = (lo - a[ax]) / d[ax], tb = (hi - a[ax]) / d[ax];
+        if (ta > tb)
+            std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+    }
+    return t0 <= t1 && std::isfinite(t0) && std::isfinite(t1);
+}
 
 Mat paddedKeep(const Mat& keep, int pad)
 {
@@ -196,8 +222,25 @@ std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camer
                 for (int sx = 0; sx < n; sx++)
                 {
                     const Point2d px(p.x + (sx + 0.5) / n - 0.5, p.y + (sy + 0.5) / n - 0.5);
-                    const Vec3d a = g.toVoxel(camera.unproject(px, z1));
-                    const Vec3d b = g.toVoxel(camera.unproject(px, z2));
+                    Vec3d a = g.toVoxel(camera.unproject(px, z1));
+                    Vec3d b = g.toVoxel(camera.unproject(px, z2));
+                    // The segment, clipped to the grid; when the estimated depths miss the grid,
+                    // and in the last round, the ray's whole span in the grid.
+                    double t0, t1;
+                    if (!clipToGrid(g, a, b, t0, t1))
+                        continue;
+                    if (round == kPatchExtraRounds || t1 < 0 || t0 > 1)
+                    {
+                        const Vec3d a0 = a;
+                        a = a0 + t0 * (b - a0);
+                        b = a0 + t1 * (b - a0);
+                    }
+                    else
+                    {
+                        const Vec3d a0 = a;
+                        a = a0 + std::max(t0, 0.0) * (b - a0);
+                        b = a0 + std::min(t1, 1.0) * (b - a0);
+                    }
                     const double len = std::max(std::abs(b[0] - a[0]),
                                                 std::max(std::abs(b[1] - a[1]), std::abs(b[2] - a[2])));
                     const int steps = (int)std::ceil(len * kSamplesPerVoxel);
