@@ -4,6 +4,9 @@
 #include "test_precomp.hpp"
 #include "test_silhouette_scene.hpp"
 
+#include <filesystem>
+#include <set>
+
 namespace opencv_test {
 namespace {
 using namespace cv;
@@ -298,6 +301,218 @@ TEST(Augocc_SilhouetteEditor, overlay_draws)
     Mat canvas = scene.image.clone();
     ed->drawOverlay(canvas, Point(50, 50));
     EXPECT_GT(norm(canvas, scene.image, NORM_L1), 0.0);
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+
+TEST(Augocc_SilhouetteEditor, resolve_visible_silhouettes)
+{
+    // Object 0 (near, z = 5) covers the left part of object 1 (far, z = 9).
+    std::vector<Mat> mattes(2), depths(2), visible;
+    for (int i = 0; i < 2; ++i)
+    {
+        mattes[i] = Mat::zeros(60, 80, CV_8U);
+        depths[i] = Mat(60, 80, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
+    }
+    rectangle(mattes[0], Rect(10, 10, 30, 30), Scalar::all(255), FILLED);
+    depths[0].setTo(5.f, mattes[0]);
+    rectangle(mattes[1], Rect(25, 5, 40, 40), Scalar::all(255), FILLED);
+    depths[1].setTo(9.f, mattes[1]);
+    resolveVisibleSilhouettes(mattes, depths, visible);
+    ASSERT_EQ(2u, visible.size());
+    EXPECT_EQ(0, norm(visible[0], mattes[0], NORM_INF));  // nothing in front of it
+    Mat expected1 = mattes[1].clone();
+    expected1.setTo(0, mattes[0]);
+    EXPECT_EQ(0, norm(visible[1], expected1, NORM_INF));
+    depths.pop_back();
+    EXPECT_THROW(resolveVisibleSilhouettes(mattes, depths, visible), cv::Exception);
+}
+
+// `augocc propagate --mattes`: coarse mattes in, snapped masks out, for the frames asked.
+TEST(Augocc_PropagateCli, mattes_snapped_and_bad_input)
+{
+    const std::string dir = tempDir("propagate");
+    std::filesystem::create_directories(dir + "/frames");
+    std::filesystem::create_directories(dir + "/mattes/building");
+    const Size size(640, 480);
+    std::vector<SilhouetteScene> scenes;
+    const Mat k = getStructuringElement(MORPH_ELLIPSE, Size(5, 5));  // 2 px radius
+    for (int f = 0; f < 3; ++f)
+    {
+        scenes.push_back(drawBoxScene(orbitCamera(30 + 3 * f, 25, size.height / 14.0, size),
+                                      size, 31 + f));
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scenes[f].image));
+        Mat coarse;
+        dilate(scenes[f].mask, coarse, k);
+        ASSERT_TRUE(imwrite(format("%s/mattes/building/%04d.png", dir.c_str(), f), coarse));
+    }
+    const std::string bin = augoccBinary();
+    std::string out;
+    const std::string base = bin + " propagate --input " + dir + "/frames";
+    ASSERT_EQ(0, runCommand(base + " --mattes " + dir + "/mattes --frames 0,2 --out " + dir +
+                            "/proposed", &out)) << out;
+    for (int f : {0, 2})
+    {
+        const Mat m = imread(format("%s/proposed/building/%04d.png", dir.c_str(), f),
+                             IMREAD_GRAYSCALE);
+        ASSERT_FALSE(m.empty()) << out;
+        const double kMinProposalIoU = 0.97;  // issue 6 target for proposed silhouettes
+        EXPECT_GE(maskIoU(m, scenes[f].mask), kMinProposalIoU) << "frame " << f;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir + "/proposed/building/0001.png"));
+    // Bad input: exit 2, a message naming the flag, no output.
+    const std::string o2 = " --out " + dir + "/bad";
+    EXPECT_EQ(2, runCommand(base + " --mattes " + dir + "/mattes --frames 0,7" + o2, &out));
+    EXPECT_NE(std::string::npos, out.find("--frames")) << out;
+    EXPECT_EQ(2, runCommand(base + " --mattes " + dir + "/mattes --frames 2:1" + o2, &out));
+    EXPECT_EQ(2, runCommand(base + " --mattes " + dir + "/mattes --frames x" + o2, &out));
+    EXPECT_EQ(2, runCommand(base + o2, &out));  // neither --clones nor --mattes
+    EXPECT_NE(std::string::npos, out.find("--mattes")) << out;
+    EXPECT_EQ(2, runCommand(base + " --mattes " + dir + "/nope" + o2, &out));
+    EXPECT_EQ(2, runCommand(base + " --clones " + dir + "/c.yml.gz" + o2, &out));
+    EXPECT_EQ(2, runCommand(bin + " propagate --input " + dir + "/none --mattes " + dir +
+                            "/mattes" + o2, &out));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/bad"));
+    std::filesystem::remove_all(dir);
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+
+// A small synthesized sequence shared by the tests below (synthesized once: ~1 s).
+const SyntheticScene& synthScene()
+{
+    static SyntheticScene scene;
+    static bool done = false;
+    if (!done)
+    {
+        SceneSynthesizer::Params p;
+        p.frames = 12;
+        p.numKeyFrames = 3;
+        p.numTracks = 200;
+        SceneSynthesizer::create(p)->synthesize(scene);
+        done = true;
+    }
+    return scene;
+}
+
+std::vector<Point> mainOutlineCorners(const Mat& mask)
+{
+    std::vector<std::vector<Point>> contours;
+    findContours(mask.clone(), contours, RETR_EXTERNAL, CHAIN_APPROX_NONE);
+    CV_Assert(!contours.empty());
+    size_t biggest = 0;
+    for (size_t i = 1; i < contours.size(); ++i)
+        if (contourArea(contours[i]) > contourArea(contours[biggest]))
+            biggest = i;
+    std::vector<Point> approx;
+    approxPolyDP(contours[biggest], approx, 2.0, true);  // the corners a user aims at
+    return approx;
+}
+
+// Done-when 1 on SceneSynthesizer frames: the box building traced in every frame of a short
+// sequence with <= 12 clicks (its corners, hit within +-2 px), against its true visible
+// silhouette. Where a facade turns edge-on it shows as a 1-3 px sliver of the same darkness as
+// the block behind it, and the wire takes the sliver's inner edge: those frames reach ~0.97.
+TEST(Augocc_SilhouetteEditor, accuracy_scripted_clicks_synthesized)
+{
+    const SyntheticScene& s = synthScene();
+    const double kMinMeanIoU = 0.98;   // issue 6: IoU >= 0.98 in <= 12 clicks
+    const double kMinWorstIoU = 0.95;  // the sliver frames (see above) with margin
+    const double kMinFractionAtTarget = 0.6;  // most frames reach the target on their own
+    const int kMaxClickCount = 12;
+    RNG rng(17);
+    double sum = 0, worst = 1;
+    int atTarget = 0;
+    const int F = int(s.frames.size());
+    std::string list;
+    for (int f = 0; f < F; ++f)
+    {
+        const Mat& truth = s.visibleMasks.at("building").at(f);
+        const std::vector<Point> corners = mainOutlineCorners(truth);
+        Ptr<SilhouetteEditor> ed = SilhouetteEditor::create();
+        ed->setImage(s.frames[f]);
+        int clicks = 0;
+        for (const Point& c : corners)
+        {
+            ed->addPoint(c + Point(rng.uniform(-2, 3), rng.uniform(-2, 3)));
+            ++clicks;
+        }
+        ASSERT_TRUE(ed->closeContour());
+        ++clicks;
+        EXPECT_LE(clicks, kMaxClickCount) << "frame " << f;
+        Mat mask;
+        ed->getMask(mask);
+        const double iou = maskIoU(mask, truth);
+        sum += iou;
+        worst = std::min(worst, iou);
+        atTarget += iou >= kMinMeanIoU ? 1 : 0;
+        list += format(" %d:%.3f(%d)", f, iou, clicks);
+    }
+    std::cout << "[ synth building, frame:IoU(clicks) ]" << list << std::endl;
+    std::cout << format("[ synth building ] mean IoU %.4f, worst %.4f, %d/%d frames >= %.2f",
+                        sum / F, worst, atTarget, F, kMinMeanIoU) << std::endl;
+    EXPECT_GE(sum / F, kMinMeanIoU);
+    EXPECT_GE(worst, kMinWorstIoU);
+    EXPECT_GE(atTarget, kMinFractionAtTarget * F);
+}
+
+// Done-when 3, measured with ground-truth-derived proposals (a clone's matte stands in: the
+// true visible silhouette grown by 2 px, as a carved clone is slightly too large, or shifted by
+// (2, -1) px, as a camera error moves it): snapped outlines on the non-key frames.
+TEST(Augocc_SilhouetteEditor, accuracy_proposals_synthesized_gt_derived)
+{
+    const SyntheticScene& s = synthScene();
+    const double kMinMeanIoU = 0.97;   // issue 6: proposed silhouettes, before any correction
+    const double kMinWorstIoU = 0.94;  // no single frame far off (regression guard)
+    const Mat grow = getStructuringElement(MORPH_ELLIPSE, Size(5, 5));
+    const Matx23d shift(1, 0, 2, 0, 1, -1);
+    std::set<int> keys(s.keyFrames.begin(), s.keyFrames.end());
+    for (int variant = 0; variant < 2; ++variant)
+    {
+        double sumBefore = 0, sumAfter = 0, worst = 1;
+        int n = 0;
+        for (int f = 0; f < int(s.frames.size()); ++f)
+        {
+            if (keys.count(f))
+                continue;
+            Ptr<SilhouetteEditor> ed = SilhouetteEditor::create();
+            ed->setImage(s.frames[f]);
+            for (const String& name : s.objectNames)
+            {
+                const Mat& truth = s.visibleMasks.at(name).at(f);
+                Mat proposal, snapped;
+                if (variant == 0)
+                    dilate(truth, proposal, grow);
+                else
+                    warpAffine(truth, proposal, shift, truth.size(), INTER_NEAREST);
+                ed->snapMask(proposal, snapped);
+                const double after = maskIoU(snapped, truth);
+                sumBefore += maskIoU(proposal, truth);
+                sumAfter += after;
+                worst = std::min(worst, after);
+                ++n;
+            }
+        }
+        std::cout << format("[ proposals %s ] %d object-frames: mean IoU %.4f -> %.4f, worst %.4f",
+                            variant == 0 ? "grown 2 px" : "shifted (2,-1)", n, sumBefore / n,
+                            sumAfter / n, worst)
+                  << std::endl;
+        EXPECT_GE(sumAfter / n, kMinMeanIoU);
+        EXPECT_GT(sumAfter, sumBefore);
+        EXPECT_GE(worst, kMinWorstIoU);
+    }
 }
 
 } // namespace

@@ -10,9 +10,9 @@ namespace augocc {
 
 SilhouetteEditor::Params::Params()
     : weightNonEdge(0.43f), weightGradientDirection(0.43f), weightGradientMagnitude(0.14f),
-      gradientMagnitudeMax(150.f), cannyLow(32), cannyHigh(100), clickSnapRadius(3),
-      searchMargin(24), outlineTolerance(1.0), snapSpacing(10), snapRadius(6),
-      minContourArea(20)
+      gradientMagnitudeMax(150.f), cannyLow(32), cannyHigh(100), clickSnapRadius(2),
+      searchMargin(24), outerEdgeBias(0.5f), outerEdgeBand(4), outlineTolerance(1.0),
+      snapSpacing(10), snapRadius(6), minContourArea(20), refineBoundary(true)
 {
 }
 
@@ -85,6 +85,21 @@ std::vector<Point> contourPolyline(const ContourData& c)
     return poly;
 }
 
+// +1 / -1 by the sign of the anchor polygon's shoelace area, 0 while open or degenerate.
+int orientation(const ContourData& c)
+{
+    if (!c.closed || c.anchors.size() < 3)
+        return 0;
+    double a = 0;
+    const size_t n = c.anchors.size();
+    for (size_t i = 0; i < n; ++i)
+    {
+        const Point p = c.anchors[i], q = c.anchors[(i + 1) % n];
+        a += double(p.x) * q.y - double(q.x) * p.y;
+    }
+    return a > 0 ? 1 : (a < 0 ? -1 : 0);
+}
+
 double pointSegmentDistance(Point2d p, Point2d a, Point2d b)
 {
     const Point2d d = b - a;
@@ -109,6 +124,10 @@ public:
                      format("SilhouetteEditor: clickSnapRadius (%d), searchMargin (%d), "
                             "snapRadius (%d) must be >= 0 and snapSpacing (%d) >= 2",
                             p.clickSnapRadius, p.searchMargin, p.snapRadius, p.snapSpacing));
+        if (!(p.outerEdgeBias >= 0) || p.outerEdgeBand < 0)
+            CV_Error(Error::StsBadArg,
+                     format("SilhouetteEditor: outerEdgeBias (%g) and outerEdgeBand (%d) must be "
+                            ">= 0", p.outerEdgeBias, p.outerEdgeBand));
         if (!(p.outlineTolerance > 0) || !(p.minContourArea >= 0))
             CV_Error(Error::StsBadArg,
                      format("SilhouetteEditor: outlineTolerance (%g) must be > 0 and "
@@ -180,8 +199,12 @@ public:
         pushUndo();
         ContourData& c = state_.back();
         c.segs[0].mode = mode_;
-        c.segs[0].path = makePath(c.anchors.back(), c.anchors.front(), mode_);
         c.closed = true;
+        // Now that inside and outside are known, the live-wire segments are traced again with
+        // the preference for the outer of two parallel edges (see liveWire()).
+        for (int k = 0; k < int(c.anchors.size()); ++k)
+            if (k == 0 || c.segs[k].mode == LIVE_WIRE)
+                recomputeSegment(c, k);
         return true;
     }
 
@@ -411,7 +434,7 @@ public:
                     anyLive = true;
                 }
         }
-        if (anyLive)
+        if (anyLive && params_.refineBoundary)
             refineBoundary(mask, liveBand);
     }
 
@@ -557,16 +580,20 @@ private:
         return best;
     }
 
-    std::vector<Point> makePath(Point a, Point b, int mode, int margin = -1) const
+    std::vector<Point> makePath(Point a, Point b, int mode, int margin = -1, int orient = 0) const
     {
         if (mode == STRAIGHT || a == b)
             return straightPath(a, b);
-        return liveWire(a, b, margin < 0 ? params_.searchMargin : margin);
+        return liveWire(a, b, margin < 0 ? params_.searchMargin : margin, orient);
     }
 
     // Minimum-cost path a -> b (Intelligent Scissors) inside the bounding box of a and b grown
     // by `margin`: the Dijkstra search of buildMap() then costs the box, not the whole frame.
-    std::vector<Point> liveWire(Point a, Point b, int margin) const
+    // With `orient` != 0 (a closed contour: +1/-1 its orientation) the outside of the chord a->b
+    // is known, and pixels up to Params::outerEdgeBand inside the chord get an extra gradient-
+    // magnitude cost (up to Params::outerEdgeBias): a silhouette is the outermost edge, and a
+    // facade's trim or shadow line just inside it would otherwise compete with it.
+    std::vector<Point> liveWire(Point a, Point b, int margin, int orient) const
     {
         Rect roi(Point(std::min(a.x, b.x) - margin, std::min(a.y, b.y) - margin),
                  Point(std::max(a.x, b.x) + margin + 1, std::max(a.y, b.y) + margin + 1));
@@ -576,12 +603,45 @@ private:
         segmentation::IntelligentScissorsMB tool;
         tool.setWeights(params_.weightNonEdge, params_.weightGradientDirection,
                         params_.weightGradientMagnitude);
-        tool.setGradientMagnitudeMaxLimit(params_.gradientMagnitudeMax);
-        tool.setEdgeFeatureCannyParameters(params_.cannyLow, params_.cannyHigh);
-        tool.applyImage(image_(roi));
-        tool.buildMap(a - roi.tl());
+        // Features of the whole frame, computed once in setImage() from the colour gradient
+        // (the scissors' own extractor takes direction and magnitude from the grey image, where
+        // two differently coloured surfaces of equal brightness show no edge).
+        Mat magCost = magnitudeCost_(roi).clone();
+        if (orient != 0 && params_.outerEdgeBias > 0 && params_.outerEdgeBand > 0)
+        {
+            const Point2f d = Point2f(b - a);
+            const float len = std::sqrt(d.dot(d));
+            // Outward normal: right of a->b for a positive shoelace area, left otherwise.
+            const Point2f out = (orient > 0 ? Point2f(d.y, -d.x) : Point2f(-d.y, d.x)) / len;
+            const float band = float(params_.outerEdgeBand);
+            for (int y = 0; y < roi.height; ++y)
+            {
+                float* row = magCost.ptr<float>(y);
+                for (int x = 0; x < roi.width; ++x)
+                {
+                    const Point2f q(float(x + roi.x - a.x), float(y + roi.y - a.y));
+                    const float inward = -(q.x * out.x + q.y * out.y);
+                    if (inward > 0)
+                        row[x] = std::min(1.f, row[x] + params_.outerEdgeBias *
+                                                            std::min(inward, band) / band);
+                }
+            }
+        }
+        tool.applyImageFeatures(nonEdge_(roi).clone(), direction_(roi).clone(), magCost);
         std::vector<Point> path;
-        tool.getContour(b - roi.tl(), path);
+        try
+        {
+            tool.buildMap(a - roi.tl());
+            tool.getContour(b - roi.tl(), path);
+        }
+        catch (const cv::Exception& e)
+        {
+            // OpenCV 4.6's getContour() rejects some maps it built itself ("Contour loop is
+            // detected"); a straight segment is then the honest answer, not a failed edit.
+            CV_LOG_DEBUG(NULL, "SilhouetteEditor: live wire " << a << " -> " << b
+                         << " failed, straight segment used: " << e.what());
+            path.clear();
+        }
         if (path.empty())
             return straightPath(a, b);
         for (Point& p : path)
@@ -602,7 +662,7 @@ private:
             return;
         }
         const Point from = c.anchors[(k - 1 + n) % n];
-        c.segs[k].path = makePath(from, c.anchors[k], c.segs[k].mode);
+        c.segs[k].path = makePath(from, c.anchors[k], c.segs[k].mode, -1, orientation(c));
     }
 
     // Gradient of the smoothed image, per pixel from the channel of largest magnitude (as the
@@ -628,6 +688,35 @@ private:
             mag.copyTo(magnitude_, better);
             dx.copyTo(gx_, better);
             dy.copyTo(gy_, better);
+        }
+        // Scissors features (Mortensen & Barrett's f_Z, f_D, f_G) from the colour gradient:
+        // non-edge = not a Canny edge of the colour image; direction = unit gradient; magnitude
+        // cost = 1 - min(|g|, max) / max.
+        Mat edges;
+        Canny(image_, edges, params_.cannyLow, params_.cannyHigh);
+        nonEdge_ = Mat(image_.size(), CV_8U);
+        nonEdge_.setTo(1);
+        nonEdge_.setTo(0, edges);
+        direction_.create(image_.size(), CV_32FC2);
+        for (int y = 0; y < image_.rows; ++y)
+        {
+            const float* mx = gx_.ptr<float>(y);
+            const float* my = gy_.ptr<float>(y);
+            const float* mm = magnitude_.ptr<float>(y);
+            Point2f* d = direction_.ptr<Point2f>(y);
+            for (int x = 0; x < image_.cols; ++x)
+                d[x] = mm[x] > FLT_EPSILON ? Point2f(mx[x] / mm[x], my[x] / mm[x]) : Point2f(0, 0);
+        }
+        double maxMag = params_.gradientMagnitudeMax;
+        if (maxMag <= 0)
+            minMaxLoc(magnitude_, nullptr, &maxMag);
+        if (maxMag <= FLT_EPSILON)
+            magnitudeCost_ = Mat::zeros(image_.size(), CV_32F);
+        else
+        {
+            Mat clipped;
+            threshold(magnitude_, clipped, maxMag, 0, THRESH_TRUNC);
+            clipped.convertTo(magnitudeCost_, CV_32F, -1.0 / maxMag, 1.0);
         }
     }
 
@@ -797,11 +886,12 @@ private:
             cd.segs.resize(m);
             // The wire between two snapped samples only needs room for a corner between them.
             const int margin = R + 4;
+            const int orient = orientation(cd);
             for (int k = 0; k < m; ++k)
             {
                 cd.segs[k].mode = LIVE_WIRE;
                 cd.segs[k].path = makePath(cd.anchors[(k - 1 + m) % m], cd.anchors[k], LIVE_WIRE,
-                                           margin);
+                                           margin, orient);
             }
             s.push_back(cd);
         }
@@ -810,6 +900,7 @@ private:
 
     Params params_;
     Mat image_, magnitude_, gx_, gy_;
+    Mat nonEdge_, direction_, magnitudeCost_;  // Intelligent Scissors features
     int mode_ = LIVE_WIRE;
     State state_;
     std::vector<State> undo_, redo_;
@@ -833,6 +924,73 @@ void snapMaskToEdges(InputArray image, InputArray proposed, OutputArray snapped,
     Ptr<SilhouetteEditor> editor = SilhouetteEditor::create(params);
     editor->setImage(image);
     editor->snapMask(proposed, snapped);
+}
+
+void resolveVisibleSilhouettes(const std::vector<Mat>& mattes, const std::vector<Mat>& depths,
+                               std::vector<Mat>& visible)
+{
+    if (mattes.size() != depths.size())
+        CV_Error(Error::StsBadSize, format("resolveVisibleSilhouettes: %d mattes but %d depth "
+                                           "maps", int(mattes.size()), int(depths.size())));
+    const size_t n = mattes.size();
+    visible.assign(n, Mat());
+    if (n == 0)
+        return;
+    const Size size = mattes[0].size();
+    for (size_t i = 0; i < n; ++i)
+    {
+        CV_CheckTypeEQ(mattes[i].type(), CV_8UC1, "resolveVisibleSilhouettes: mattes");
+        CV_CheckTypeEQ(depths[i].type(), CV_32FC1, "resolveVisibleSilhouettes: depths");
+        if (mattes[i].size() != size || depths[i].size() != size)
+            CV_Error(Error::StsBadSize, format("resolveVisibleSilhouettes: object %d has a "
+                                               "matte or depth map of another size", int(i)));
+    }
+    // Nearest depth over all objects' mattes, then each object keeps the pixels where it is the
+    // nearest (ties: visible for both).
+    Mat nearest(size, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
+    for (size_t i = 0; i < n; ++i)
+    {
+        Mat in = mattes[i] > 127;
+        Mat d = Mat(size, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
+        depths[i].copyTo(d, in);
+        min(nearest, d, nearest);
+    }
+    for (size_t i = 0; i < n; ++i)
+    {
+        Mat in = mattes[i] > 127;
+        Mat front = depths[i] <= nearest;
+        visible[i] = in & front;
+    }
+}
+
+void proposeSilhouettes(const CloneSet& clones, int frame, const Camera& camera,
+                        InputArray _image, std::map<String, Mat>& proposals, bool snap,
+                        const SilhouetteEditor::Params& params)
+{
+    Mat image = _image.getMat();
+    if (image.empty())
+        CV_Error(Error::StsBadArg, format("proposeSilhouettes: empty image for frame %d", frame));
+    const std::vector<String> names = clones.objectNames();
+    std::vector<Mat> mattes(names.size()), depths(names.size()), visible;
+    for (size_t i = 0; i < names.size(); ++i)
+        clones.render(names[i], frame, camera, image.size(), mattes[i], depths[i]);
+    resolveVisibleSilhouettes(mattes, depths, visible);
+    proposals.clear();
+    Ptr<SilhouetteEditor> editor;
+    if (snap)
+    {
+        editor = SilhouetteEditor::create(params);
+        editor->setImage(image);
+    }
+    for (size_t i = 0; i < names.size(); ++i)
+    {
+        Mat out;
+        if (snap && countNonZero(visible[i]) > 0)
+            editor->snapMask(visible[i], out);
+        else
+            out = visible[i];
+        proposals[names[i]] = out;
+    }
 }
 
 } // namespace augocc

@@ -19,6 +19,7 @@ the real objects, and compositing by depth test.
 #include "opencv2/augocc/feature_tracker.hpp"
 #include "opencv2/augocc/factorization_sfm.hpp"
 #include "opencv2/augocc/camera_refiner.hpp"
+#include "opencv2/augocc/sfm_export.hpp"
 #include "opencv2/augocc/clone_builder.hpp"
 #include "opencv2/augocc/compositor.hpp"
 #include "opencv2/augocc/scene.hpp"

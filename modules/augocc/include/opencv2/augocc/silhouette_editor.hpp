@@ -4,8 +4,10 @@
 #ifndef OPENCV_AUGOCC_SILHOUETTE_EDITOR_HPP
 #define OPENCV_AUGOCC_SILHOUETTE_EDITOR_HPP
 
+#include <map>
 #include <vector>
 #include <opencv2/core.hpp>
+#include "opencv2/augocc/camera.hpp"
 
 /*
 Silhouette tracing (the paper's Section 5): the user outlines a real object in a key frame with
@@ -54,11 +56,17 @@ public:
         //! Canny thresholds of the edge feature (default 32, 100, as in OpenCV's scissors demo).
         double cannyLow, cannyHigh;
         //! LIVE_WIRE clicks are moved to the strongest edge pixel within this radius (pixels,
-        //! default 3; 0 keeps the click as given).
+        //! default 2; 0 keeps the click as given).
         int clickSnapRadius;
         //! Live wire is searched inside the bounding box of its two anchors grown by this margin
         //! (pixels, default 24): bounded cost, and no detour through far-away texture.
         int searchMargin;
+        //! Once a contour is closed its outside is known: live-wire pixels up to outerEdgeBand
+        //! pixels inside the chord of their segment cost up to outerEdgeBias more (gradient-
+        //! magnitude feature, range [0, 1]), so the wire takes the outer of two parallel edges
+        //! (a silhouette rather than a trim just inside it). Defaults 0.5 and 4; 0 disables.
+        float outerEdgeBias;
+        int outerEdgeBand;
         //! loadMask(): tolerance of the polygon approximation of a mask outline (pixels,
         //! default 1.0).
         double outlineTolerance;
@@ -69,6 +77,10 @@ public:
         //! Contours whose area is below this are ignored when a mask is loaded (pixels,
         //! default 20).
         double minContourArea;
+        //! getMask(): a live-wire pixel on the mask's boundary is kept only when its colour is
+        //! nearer to the inside neighbour's than to the outside one's (the wire runs on edge
+        //! pixels, which belong to either side). Default true.
+        bool refineBoundary;
     };
 
     /** @brief Creates an editor.
@@ -197,6 +209,37 @@ public:
 */
 CV_EXPORTS void snapMaskToEdges(InputArray image, InputArray proposed, OutputArray snapped,
                                 const SilhouetteEditor::Params& params = SilhouetteEditor::Params());
+
+/** @brief Visible parts of several objects' mattes by a depth test: a pixel of object i's matte
+is visible unless another object's matte covers it at a smaller depth.
+@param mattes per object CV_8U (> 127 inside), all of one size.
+@param depths per object CV_32F camera-space z (where the matte is set), same size.
+@param visible output per object CV_8U, 255 where visible.
+*/
+CV_EXPORTS void resolveVisibleSilhouettes(const std::vector<Mat>& mattes,
+                                          const std::vector<Mat>& depths,
+                                          std::vector<Mat>& visible);
+
+class CloneSet;
+
+/** @brief Proposed silhouettes of every object of a clone set in one frame (the paper's stated
+future work): each clone is rendered into the frame, what nearer clones hide is removed
+(resolveVisibleSilhouettes()), and the outline is snapped to the frame's edges
+(SilhouetteEditor::snapMask()). The user then only corrects.
+@param clones the clones.
+@param frame frame index (selects the patch set).
+@param camera the frame's camera.
+@param image the frame, CV_8UC1 or CV_8UC3.
+@param proposals output: object name -> CV_8U mask (255 inside); objects that are not visible get
+an all-zero mask.
+@param snap snap to the image edges (false: the depth-resolved mattes as they are).
+@param params snapping parameters.
+*/
+CV_EXPORTS void proposeSilhouettes(const CloneSet& clones, int frame, const Camera& camera,
+                                   InputArray image, std::map<String, Mat>& proposals,
+                                   bool snap = true,
+                                   const SilhouetteEditor::Params& params =
+                                       SilhouetteEditor::Params());
 
 //! @}
 
