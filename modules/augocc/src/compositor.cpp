@@ -13,6 +13,7 @@
 #include <map>
 #include <tuple>
 #include <unordered_map>
+#include <opencv2/ximgproc.hpp>
 #include <GL/osmesa.h>
 #include <GL/gl.h>
 
@@ -42,7 +43,7 @@ Camera supersampledCamera(const Camera& camera, int factor)
 }
 
 Compositor::Params::Params()
-    : supersample(3), cullBackFaces(true)
+    : supersample(3), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2)
 {
 }
 
@@ -156,6 +157,11 @@ public:
         if (p.supersample < 1 || p.supersample > 8)
             CV_Error(Error::StsBadArg, cv::format("Compositor: supersample must be in [1, 8], "
                      "got %d", p.supersample));
+        if (p.edgeRadius < 0 || p.edgeRadius > 16)
+            CV_Error(Error::StsBadArg, cv::format("Compositor: edgeRadius must be in [0, 16], "
+                     "got %d", p.edgeRadius));
+        if (!(p.edgeEps > 0))
+            CV_Error(Error::StsBadArg, "Compositor: edgeEps must be positive");
         params_ = p;
     }
 
@@ -260,8 +266,8 @@ public:
         // back and blended (a multiple of k, so that it maps onto whole frame pixels).
         const Rect roi = meshes_.empty() ? Rect() : screenRoi(rc, rsz, k, zNear);
 
-        Mat rgba;  // frame grid, ROI only, rows bottom-up
-        Mat zRoi;  // render grid, ROI only, camera z of the nearest surface (depth output)
+        Mat layerRoi;  // frame grid, ROI only: premultiplied RGB + alpha, CV_32FC4, top-down
+        Mat zRoi;      // render grid, ROI only: camera z of the virtual surface (+inf: none)
         if (roi.area() > 0)
         {
             const int winY = rsz.height - roi.y - roi.height;
@@ -274,33 +280,22 @@ public:
             glDisable(GL_BLEND);
             glDisable(GL_DITHER);
             glEnable(GL_DEPTH_TEST);
-
-            if (!occ.empty())
-                drawOccluderDepth(camera, occ(roi), zNear, zFar, roi.tl(), winY);
             drawMeshes(rc, rsz, zNear, zFar);
-
             glFinish();
-            Mat rgbaUp(roi.size(), CV_8UC4);
+            Mat rgbaUp(roi.size(), CV_8UC4), depthUp(roi.size(), CV_32F);
             glPixelStorei(GL_PACK_ALIGNMENT, 4);
             glReadPixels(roi.x, winY, roi.width, roi.height, GL_RGBA, GL_UNSIGNED_BYTE,
                          rgbaUp.data);
-            if (k > 1)
-                cv::resize(rgbaUp, rgba, Size(roi.width / k, roi.height / k), 0, 0, INTER_AREA);
-            else
-                rgba = rgbaUp;
-            if (depthOut.needed())
-            {
-                Mat d(roi.size(), CV_32F), flipped;
-                glPixelStorei(GL_PACK_ALIGNMENT, 4);
-                glReadPixels(roi.x, winY, roi.width, roi.height, GL_DEPTH_COMPONENT, GL_FLOAT,
-                             d.data);
-                cv::flip(d, flipped, 0);
-                detail::windowDepthToCameraZ(camera, flipped, zNear, zFar, zRoi);
-            }
+            glReadPixels(roi.x, winY, roi.width, roi.height, GL_DEPTH_COMPONENT, GL_FLOAT,
+                         depthUp.data);
             glDisable(GL_SCISSOR_TEST);
+            frameRoi_ = frame(Rect(roi.x / k, roi.y / k, roi.width / k, roi.height / k));
+            resolve(camera, rgbaUp, depthUp, occ.empty() ? Mat() : occ(roi), zNear, zFar, k,
+                    layerRoi, zRoi);
         }
         const Rect froi(roi.x / k, roi.y / k, roi.width / k, roi.height / k);
-        blend(frame, rgba, froi, result, virtualLayer);
+        blend(frame, layerRoi, froi, result, virtualLayer);
+        frameRoi_ = Mat();
         if (depthOut.needed())
             writeDepth(occ, zRoi, roi, rsz, fsz, k, depthOut);
     }
@@ -486,43 +481,131 @@ private:
         return Rect(ix0, iy0, ix1 - ix0, iy1 - iy0);
     }
 
-    // Window depth of camera z for glProjection(cam, ..., zNear, zFar): (ndc + 1) / 2.
-    static inline float windowDepth(bool ortho, double z, double zNear, double zFar)
+    // The depth test against the real objects, per sample of the render grid, and the box
+    // average to the frame grid: camera z of each virtual sample (from its window depth) against
+    // the occluder's camera z, so that both compare in one metric whatever the camera model.
+    // Output per frame pixel: the visible virtual colour (premultiplied) and coverage; with soft
+    // edges, the visible fraction refined on the frame by a guided filter near the occlusion
+    // boundary.
+    void resolve(const Camera& cam, const Mat& rgbaUp, const Mat& depthUp, const Mat& occ,
+                 double zNear, double zFar, int k, Mat& layer, Mat& zVirtual) const
     {
-        if (!(z < std::numeric_limits<double>::infinity()))
-            return 1.f;
-        double w;
-        if (ortho)
-            w = (z - zNear) / (zFar - zNear);
-        else
-            w = z <= zNear ? 0.0 : zFar * (z - zNear) / ((zFar - zNear) * z);
-        return (float)std::min(1.0, std::max(0.0, w));
-    }
-
-    // The clones go into the depth buffer only (colour writes off), as window depth of the same
-    // projection the virtual objects use; rows bottom-up as GL expects.
-    void drawOccluderDepth(const Camera& cam, const Mat& occ, double zNear, double zFar,
-                           Point origin, int winY)
-    {
+        const Size up = rgbaUp.size(), sz(up.width / k, up.height / k);
         const bool ortho = cam.model == SCALED_ORTHOGRAPHIC;
-        const Size sz = occ.size();
-        windowBuf_.create(sz, CV_32F);
+        const float inf = std::numeric_limits<float>::infinity();
+        zVirtual.create(up, CV_32F);
+        layer.create(sz, CV_32FC4);
+        // Visible fraction of the virtual coverage and the unoccluded premultiplied colour,
+        // for the refinement.
+        Mat visFrac(sz, CV_32F), allColor(sz, CV_32FC4);
+        const float inv = 1.f / (255.f * k * k), invN = 1.f / (k * k);
         cv::parallel_for_(Range(0, sz.height), [&](const Range& r) {
             for (int y = r.start; y < r.end; y++)
             {
-                const float* src = occ.ptr<float>(y);
-                float* dst = windowBuf_.ptr<float>(sz.height - 1 - y);
+                for (int j = 0; j < k; j++)
+                {
+                    const int yu = y * k + j;  // top-down row of the render grid
+                    const float* d = depthUp.ptr<float>(up.height - 1 - yu);
+                    const uchar* c = rgbaUp.ptr<uchar>(up.height - 1 - yu);
+                    float* zo = zVirtual.ptr<float>(yu);
+                    for (int x = 0; x < up.width; x++)
+                    {
+                        if (c[4 * x + 3] == 0)
+                        {
+                            zo[x] = inf;
+                            continue;
+                        }
+                        const double ndc = 2.0 * d[x] - 1.0;
+                        zo[x] = ortho ? (float)(0.5 * (ndc * (zFar - zNear) + zFar + zNear))
+                                      : (float)(2 * zFar * zNear /
+                                                ((zFar + zNear) - ndc * (zFar - zNear)));
+                    }
+                }
+                Vec4f* out = layer.ptr<Vec4f>(y);
+                Vec4f* all = allColor.ptr<Vec4f>(y);
+                float* vf = visFrac.ptr<float>(y);
                 for (int x = 0; x < sz.width; x++)
-                    dst[x] = windowDepth(ortho, src[x], zNear, zFar);
+                {
+                    float vis[4] = {0, 0, 0, 0}, tot[4] = {0, 0, 0, 0};
+                    for (int j = 0; j < k; j++)
+                    {
+                        const int yu = y * k + j;
+                        const uchar* c = rgbaUp.ptr<uchar>(up.height - 1 - yu) + 4 * x * k;
+                        const float* zv = zVirtual.ptr<float>(yu) + x * k;
+                        const float* zo = occ.empty() ? nullptr : occ.ptr<float>(yu) + x * k;
+                        for (int i = 0; i < k; i++, c += 4)
+                        {
+                            if (c[3] == 0)
+                                continue;
+                            tot[0] += c[2];
+                            tot[1] += c[1];
+                            tot[2] += c[0];
+                            tot[3] += 255.f;
+                            if (zo && !(zv[i] < zo[i]))
+                                continue;  // a real object is in front
+                            vis[0] += c[2];
+                            vis[1] += c[1];
+                            vis[2] += c[0];
+                            vis[3] += 255.f;
+                        }
+                    }
+                    // BGR premultiplied, in [0, 1].
+                    out[x] = Vec4f(vis[0] * inv, vis[1] * inv, vis[2] * inv, vis[3] * inv);
+                    all[x] = Vec4f(tot[0] * inv, tot[1] * inv, tot[2] * inv, tot[3] * inv);
+                    vf[x] = tot[3] > 0 ? vis[3] / tot[3] : 1.f;
+                }
             }
         });
-        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-        glDepthMask(GL_TRUE);
-        glDepthFunc(GL_ALWAYS);
-        glApi_.windowPos2i(origin.x, winY);
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        glDrawPixels(sz.width, sz.height, GL_DEPTH_COMPONENT, GL_FLOAT, windowBuf_.data);
-        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        (void)invN;
+        if (occ.empty() || params_.edgeRadius <= 0 || !frameRoi_.data)
+            return;
+        refineOcclusion(visFrac, allColor, layer);
+    }
+
+    // Soft occlusion edges beyond the supersampling: where a clone hides part of a virtual
+    // object, the visible fraction m is re-estimated by a guided filter on the frame, in a band
+    // of edgeRadius pixels around the occlusion boundary, so that the boundary follows the real
+    // object's edge in the image (clones are only as exact as their voxels) and is as soft as
+    // that edge. The refined colour is the visible colour plus (m' - m) times the unoccluded one.
+    void refineOcclusion(const Mat& visFrac, const Mat& allColor, Mat& layer) const
+    {
+        const Size sz = visFrac.size();
+        Mat alphaAll;
+        cv::extractChannel(allColor, alphaAll, 3);
+        Mat covered = alphaAll > 0;
+        Mat hidden = (visFrac < 0.5f) & covered;
+        if (cv::countNonZero(hidden) == 0)
+            return;
+        const int r = params_.edgeRadius;
+        const Mat se = getStructuringElement(MORPH_ELLIPSE, Size(2 * r + 1, 2 * r + 1));
+        Mat grown, shrunk;
+        cv::dilate(hidden, grown, se);
+        cv::erode(hidden, shrunk, se, Point(-1, -1), 1, BORDER_CONSTANT, Scalar(0));
+        const Mat band = grown & ~shrunk & covered;
+        if (cv::countNonZero(band) == 0)
+            return;
+        Mat guide, refined;
+        frameRoi_.convertTo(guide, CV_32F, 1.0 / 255);
+        cv::ximgproc::guidedFilter(guide, visFrac, refined, r, params_.edgeEps);
+        cv::parallel_for_(Range(0, sz.height), [&](const Range& rr) {
+            for (int y = rr.start; y < rr.end; y++)
+            {
+                const uchar* b = band.ptr<uchar>(y);
+                const float* m = visFrac.ptr<float>(y);
+                const float* q = refined.ptr<float>(y);
+                const Vec4f* all = allColor.ptr<Vec4f>(y);
+                Vec4f* out = layer.ptr<Vec4f>(y);
+                for (int x = 0; x < sz.width; x++)
+                {
+                    if (!b[x])
+                        continue;
+                    const float mq = std::min(1.f, std::max(0.f, q[x]));
+                    out[x] += (mq - m[x]) * all[x];
+                    for (int c = 0; c < 4; c++)
+                        out[x][c] = std::min(1.f, std::max(0.f, out[x][c]));
+                }
+            }
+        });
     }
 
     void drawMeshes(const Camera& cam, Size rsz, double zNear, double zFar)
@@ -576,10 +659,10 @@ private:
         glApi_.bindBuffer(kElementArrayBuffer, 0);
     }
 
-    // result = frame * (1 - a) + premultiplied colour, inside `roi` (frame grid); the frame
-    // elsewhere. The layer has straight alpha. `rgba` rows are bottom-up (GL), RGB order.
-    static void blend(const Mat& frame, const Mat& rgba, const Rect& roi, OutputArray resultArr,
-                      OutputArray layerArr)
+    // result = frame * (1 - a) + premultiplied colour inside `roi` (frame grid); the frame
+    // elsewhere. The output layer has straight alpha.
+    static void blend(const Mat& frame, const Mat& layerRoi, const Rect& roi,
+                      OutputArray resultArr, OutputArray layerArr)
     {
         const Size sz = frame.size();
         resultArr.create(sz, CV_8UC3);
@@ -599,29 +682,23 @@ private:
             {
                 const int y = roi.y + j;
                 const uchar* f = frame.ptr<uchar>(y) + 3 * roi.x;
-                const uchar* c = rgba.ptr<uchar>(roi.height - 1 - j);
+                const Vec4f* c = layerRoi.ptr<Vec4f>(j);
                 uchar* o = result.ptr<uchar>(y) + 3 * roi.x;
                 uchar* l = layer.empty() ? nullptr : layer.ptr<uchar>(y) + 4 * roi.x;
-                for (int x = 0; x < roi.width; x++, f += 3, c += 4, o += 3)
+                for (int x = 0; x < roi.width; x++, f += 3, o += 3)
                 {
-                    const int a = c[3];
-                    if (a == 0)
-                    {
-                        if (l)
-                            l += 4;
+                    const Vec4f& v = c[x];
+                    if (v[3] <= 0.f)
                         continue;
-                    }
-                    const int ia = 255 - a;
-                    o[0] = saturate_cast<uchar>((c[2] * 255 + f[0] * ia + 127) / 255);
-                    o[1] = saturate_cast<uchar>((c[1] * 255 + f[1] * ia + 127) / 255);
-                    o[2] = saturate_cast<uchar>((c[0] * 255 + f[2] * ia + 127) / 255);
+                    const float ia = 1.f - v[3];
+                    for (int ch = 0; ch < 3; ch++)
+                        o[ch] = saturate_cast<uchar>(255.f * v[ch] + f[ch] * ia);
                     if (l)
                     {
-                        l[0] = saturate_cast<uchar>((c[2] * 255 + a / 2) / a);
-                        l[1] = saturate_cast<uchar>((c[1] * 255 + a / 2) / a);
-                        l[2] = saturate_cast<uchar>((c[0] * 255 + a / 2) / a);
-                        l[3] = (uchar)a;
-                        l += 4;
+                        uchar* lp = l + 4 * x;
+                        for (int ch = 0; ch < 3; ch++)
+                            lp[ch] = saturate_cast<uchar>(255.f * v[ch] / v[3]);
+                        lp[3] = saturate_cast<uchar>(255.f * v[3]);
                     }
                 }
             }
@@ -669,7 +746,7 @@ private:
     std::unique_ptr<detail::GlContext> gl_;
     GlBufferApi glApi_;
     std::vector<GpuMesh> gpu_;
-    Mat windowBuf_;
+    Mat frameRoi_;  // the frame under the ROI, guide of the refinement (during composite())
 };
 
 } // namespace

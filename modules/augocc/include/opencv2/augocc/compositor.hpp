@@ -58,6 +58,15 @@ public:
         when uploaded; such back faces are never visible, so no pixel changes). Halves the
         triangles the rasteriser sets up (default true). */
         bool cullBackFaces;
+        /** Optional occlusion-edge refinement: radius in frame pixels of a guided filter
+        (cv::ximgproc::guidedFilter, guided by the frame) that re-estimates the visible fraction
+        of the virtual objects around the occlusion boundary, so that it follows the real
+        object's edge in the image. Default 0 (off): on richly textured real objects the filter
+        follows the texture and measured worse than the supersampled depth test alone
+        (doc/compositor.md); it helps on plain objects with clean edges. */
+        int edgeRadius;
+        //! Regularisation of that guided filter, guide in [0, 1] (default 1e-2).
+        double edgeEps;
     };
 
     static Ptr<Compositor> create(const Params& params);
