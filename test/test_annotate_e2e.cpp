@@ -23,10 +23,15 @@
 namespace opencv_test {
 namespace {
 using namespace cv;
+using namespace cv::augocc;
 namespace fs = std::filesystem;
 
-// Same target as the headless test (issue 6: IoU >= 0.98 with <= 12 clicks).
-const double kMinE2eIoU = 0.98;
+// The window must give exactly what the library gives for the same clicks (the e2e test checks
+// the plumbing: click mapping, closing, saving); against the truth, this near-frontal view has
+// the thin-sliver facade of accuracy_scripted_clicks_synthesized, which reaches ~0.97.
+const double kMinE2eIoU = 0.965;
+// Frame 1 proposed from frame 0 (key g): a neighbour's outline snapped to this frame's edges.
+const double kMinProposedIoU = 0.95;
 // Generous limits: the window appears in ~1 s on an idle machine; 2 cores shared with builds.
 const double kStartTimeoutS = 40.0;
 const double kExitTimeoutS = 30.0;
@@ -184,17 +189,21 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     if (!shots.empty() && !haveTool("ffmpeg"))
         GTEST_SKIP() << "AUGOCC_ANNOTATE_SHOTS set but ffmpeg missing";
 
-    // Three frames of a box building seen from a slowly turning camera.
+    // Three frames of the synthesized scene from a slowly turning camera (2 degrees a frame).
     const std::string dir = tempDir("annotate");
     fs::create_directories(dir + "/frames");
-    const Size size(640, 480);
-    std::vector<SilhouetteScene> scenes;
+    SceneSynthesizer::Params sp;
+    sp.frames = 3;
+    sp.numKeyFrames = 2;
+    sp.orbitDegrees = 4;
+    sp.numTracks = 50;
+    SyntheticScene scene;
+    SceneSynthesizer::create(sp)->synthesize(scene);
+    const Size size = scene.frames[0].size();
     for (int f = 0; f < 3; ++f)
-    {
-        scenes.push_back(drawBoxScene(orbitCamera(30 + 2 * f, 25, size.height / 14.0, size),
-                                      size, 21));
-        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scenes.back().image));
-    }
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scene.frames[f]));
+    const Mat truth0 = scene.visibleMasks.at("building").at(0);
+    const Mat truth1 = scene.visibleMasks.at("building").at(1);
     const std::string masks = dir + "/masks";
 
     const int dispNum = freeDisplay();
@@ -245,7 +254,7 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
 
     // Trace: the building's corners, a couple of pixels off as a hand would be.
     std::vector<std::vector<Point>> contours;
-    findContours(scenes[0].mask.clone(), contours, RETR_EXTERNAL, CHAIN_APPROX_NONE);
+    findContours(truth0.clone(), contours, RETR_EXTERNAL, CHAIN_APPROX_NONE);
     ASSERT_FALSE(contours.empty());
     std::vector<Point> corners;
     approxPolyDP(contours[0], corners, 2.0, true);
@@ -281,6 +290,10 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     }
     xdo.key("w");       // the tool's own screenshot of its canvas
     xdo.key("n");       // next frame: the traced frame is committed
+    xdo.key("g");       // propose frame 1's outline from frame 0's, snapped to edges
+    sleepMs(500);
+    if (!shots.empty())
+        grab(display, rect, shots + "/annotate_proposed.png");
     xdo.key("q");       // save and quit
     const int rc = tool.wait(kExitTimeoutS);
     const std::string text = readFile(log);
@@ -290,10 +303,29 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     const Mat written = imread(masks + "/building/0000.png", IMREAD_GRAYSCALE);
     ASSERT_FALSE(written.empty()) << "no mask written:\n" << text;
     EXPECT_EQ(size, written.size());
-    const double iou = maskIoU(written, scenes[0].mask);
-    std::cout << format("[ annotate e2e ] %d clicks, IoU %.4f", clickCount, iou) << std::endl;
+    const double iou = maskIoU(written, truth0);
+    const Mat proposed = imread(masks + "/building/0001.png", IMREAD_GRAYSCALE);
+    ASSERT_FALSE(proposed.empty()) << "the proposal of frame 1 was not saved:\n" << text;
+    const double iouProposed = maskIoU(proposed, truth1);
+    std::cout << format("[ annotate e2e ] %d clicks, IoU %.4f; frame 1 proposed (g), IoU %.4f",
+                        clickCount, iou, iouProposed)
+              << std::endl;
     EXPECT_GE(iou, kMinE2eIoU);
-    EXPECT_FALSE(fs::exists(masks + "/building/0001.png")) << "frame 1 was not traced";
+    EXPECT_GE(iouProposed, kMinProposedIoU);
+    // The same clicks and the same proposal through the library, headless: identical masks.
+    Ptr<SilhouetteEditor> ed = SilhouetteEditor::create();
+    ed->setImage(scene.frames[0]);
+    for (const Point& c : clicks)
+        ed->addPoint(c);
+    ASSERT_TRUE(ed->closeContour());
+    Mat headless0, headless1;
+    ed->getMask(headless0);
+    EXPECT_EQ(0, norm(written, headless0, NORM_INF)) << "window and library disagree";
+    ed->setImage(scene.frames[1]);
+    ed->loadMask(headless0, true);
+    ed->getMask(headless1);
+    EXPECT_EQ(0, norm(proposed, headless1, NORM_INF)) << "window and library disagree (g)";
+    EXPECT_FALSE(fs::exists(masks + "/building/0002.png")) << "frame 2 was not traced";
     bool shot = false;
     for (const auto& e : fs::directory_iterator(dir))
         shot = shot || e.path().filename().string().rfind("annotate_building_0000", 0) == 0;
