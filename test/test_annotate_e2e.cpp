@@ -335,3 +335,32 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
 
 } // namespace
 } // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+
+// Bad input is reported before any window opens (exit 2, the flag named), display or not.
+TEST(Augocc_AnnotateE2e, bad_input)
+{
+    const std::string dir = tempDir("annotate_bad");
+    fs::create_directories(dir + "/frames");
+    ASSERT_TRUE(imwrite(dir + "/frames/0000.png", Mat(60, 80, CV_8UC3, Scalar::all(100))));
+    const std::string bin = augoccBinary() + " annotate";
+    std::string out;
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/none --masks " + dir + "/m", &out));
+    EXPECT_NE(std::string::npos, out.find("--input")) << out;
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                            "/m --suggest 3", &out));
+    EXPECT_NE(std::string::npos, out.find("--suggest")) << out;
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                            "/m --object a/b", &out));
+    EXPECT_EQ(2, runCommand("env -u DISPLAY -u WAYLAND_DISPLAY " + bin + " --input " + dir +
+                            "/frames --masks " + dir + "/m", &out));
+    EXPECT_NE(std::string::npos, out.find("DISPLAY")) << out;
+    EXPECT_FALSE(fs::exists(dir + "/m"));
+    fs::remove_all(dir);
+}
+
+} // namespace
+} // namespace opencv_test

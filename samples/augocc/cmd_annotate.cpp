@@ -4,6 +4,7 @@
 
 #include "cli_common.hpp"
 
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -78,6 +79,10 @@ public:
         suggestKeyFrameMarks();
         frame_ = std::min(std::max(opt_.frame, 0), frameCount_ - 1);
         loadFrame();
+        // Qt aborts the process when it cannot reach a display: say so first.
+        if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY"))
+            throw UsageError("annotate opens a window and needs a display: set DISPLAY (or run "
+                             "it under xvfb-run)");
 
         namedWindow(kWindow, WINDOW_AUTOSIZE | WINDOW_GUI_NORMAL);
         setMouseCallback(kWindow, &AnnotateApp::onMouse, this);
