@@ -355,6 +355,9 @@ TEST(Augocc_AnnotateE2e, bad_input)
     EXPECT_NE(std::string::npos, out.find("--suggest")) << out;
     EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
                             "/m --object a/b", &out));
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                            "/m --frame 3", &out));
+    EXPECT_NE(std::string::npos, out.find("--frame")) << out;
     EXPECT_EQ(2, runCommand("env -u DISPLAY -u WAYLAND_DISPLAY " + bin + " --input " + dir +
                             "/frames --masks " + dir + "/m", &out));
     EXPECT_NE(std::string::npos, out.find("DISPLAY")) << out;

@@ -291,6 +291,28 @@ TEST(Augocc_SilhouetteEditor, accuracy_snap_proposed_mask)
     EXPECT_TRUE(ed->canUndo());
 }
 
+TEST(Augocc_SilhouetteEditor, multithread_reproducibility)
+{
+    SilhouetteScene scene = makeBoxScene(Size(640, 480), 9);
+    Mat proposal;
+    dilate(scene.mask, proposal, getStructuringElement(MORPH_ELLIPSE, Size(7, 7)));
+    Mat snapped[2], traced[2];
+    const int threads[2] = {1, 4};
+    for (int i = 0; i < 2; ++i)
+    {
+        setNumThreads(threads[i]);
+        Ptr<SilhouetteEditor> ed = SilhouetteEditor::create();
+        ed->setImage(scene.image);
+        ed->snapMask(proposal, snapped[i]);
+        for (const Point& c : outlineCorners(scene.mask))
+            ed->addPoint(c);
+        ASSERT_TRUE(ed->closeContour());
+        ed->getMask(traced[i]);
+    }
+    EXPECT_EQ(0, norm(snapped[0], snapped[1], NORM_INF));
+    EXPECT_EQ(0, norm(traced[0], traced[1], NORM_INF));
+}
+
 TEST(Augocc_SilhouetteEditor, overlay_draws)
 {
     SilhouetteScene scene = makeBoxScene(Size(320, 240), 8);

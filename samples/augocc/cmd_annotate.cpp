@@ -77,7 +77,10 @@ public:
         if (!opt_.objects.empty())
             object_ = indexOf(opt_.objects.front());
         suggestKeyFrameMarks();
-        frame_ = std::min(std::max(opt_.frame, 0), frameCount_ - 1);
+        if (opt_.frame < 0 || opt_.frame >= frameCount_)
+            throw UsageError(format("--frame %d: the input has frames 0..%d", opt_.frame,
+                                    frameCount_ - 1));
+        frame_ = opt_.frame;
         loadFrame();
         // Qt aborts the process when it cannot reach a display: say so first.
         if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY"))
