@@ -30,7 +30,8 @@ namespace fs = std::filesystem;
 // the plumbing: click mapping, closing, saving); against the truth, this near-frontal view has
 // the thin-sliver facade of accuracy_scripted_clicks_synthesized, which reaches ~0.97.
 const double kMinE2eIoU = 0.965;
-// Frame 1 proposed from frame 0 (key g): a neighbour's outline snapped to this frame's edges.
+// Frame 1 proposed from the clone (key g; a clone of only two key frames 4 degrees apart, so
+// coarse in depth), snapped to this frame's edges.
 const double kMinProposedIoU = 0.95;
 // Generous limits: the window appears in ~1 s on an idle machine; 2 cores shared with builds.
 const double kStartTimeoutS = 40.0;
@@ -202,6 +203,10 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     const Size size = scene.frames[0].size();
     for (int f = 0; f < 3; ++f)
         ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scene.frames[f]));
+    // Clones from the two default key frames (0 and 2): the g key on frame 1 proposes from them.
+    writeReconstruction(dir + "/rec.yml", scene.groundTruth);
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks);
+    clones->save(dir + "/clones.yml.gz");
     const Mat truth0 = scene.visibleMasks.at("building").at(0);
     const Mat truth1 = scene.visibleMasks.at("building").at(1);
     const std::string masks = dir + "/masks";
@@ -221,7 +226,8 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     Child tool;
     const std::string log = dir + "/annotate.log";
     tool.pid = spawn({bin, "annotate", "--input", dir + "/frames", "--masks", masks, "--object",
-                      "building", "--screenshot-dir", dir},
+                      "building", "--screenshot-dir", dir, "--reconstruction", dir + "/rec.yml",
+                      "--clones", dir + "/clones.yml.gz"},
                      {"DISPLAY=" + display, "QT_QPA_PLATFORM=xcb"}, log);
     ASSERT_GT(tool.pid, 0);
     Rect rect;
@@ -290,7 +296,7 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     }
     xdo.key("w");       // the tool's own screenshot of its canvas
     xdo.key("n");       // next frame: the traced frame is committed
-    xdo.key("g");       // propose frame 1's outline from frame 0's, snapped to edges
+    xdo.key("g");       // propose frame 1's outline from the clone, snapped to edges
     sleepMs(500);
     if (!shots.empty())
         grab(display, rect, shots + "/annotate_proposed.png");
@@ -307,7 +313,8 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     const Mat proposed = imread(masks + "/building/0001.png", IMREAD_GRAYSCALE);
     ASSERT_FALSE(proposed.empty()) << "the proposal of frame 1 was not saved:\n" << text;
     const double iouProposed = maskIoU(proposed, truth1);
-    std::cout << format("[ annotate e2e ] %d clicks, IoU %.4f; frame 1 proposed (g), IoU %.4f",
+    std::cout << format("[ annotate e2e ] %d clicks, IoU %.4f; frame 1 proposed from the clone "
+                        "(g), IoU %.4f",
                         clickCount, iou, iouProposed)
               << std::endl;
     EXPECT_GE(iou, kMinE2eIoU);
@@ -321,8 +328,10 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     Mat headless0, headless1;
     ed->getMask(headless0);
     EXPECT_EQ(0, norm(written, headless0, NORM_INF)) << "window and library disagree";
+    std::map<String, Mat> visible;
+    proposeSilhouettes(*clones, 1, scene.groundTruth.camera(1), scene.frames[1], visible, false);
     ed->setImage(scene.frames[1]);
-    ed->loadMask(headless0, true);
+    ed->loadMask(visible.at("building"), true);
     ed->getMask(headless1);
     EXPECT_EQ(0, norm(proposed, headless1, NORM_INF)) << "window and library disagree (g)";
     EXPECT_FALSE(fs::exists(masks + "/building/0002.png")) << "frame 2 was not traced";
@@ -358,6 +367,10 @@ TEST(Augocc_AnnotateE2e, bad_input)
     EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
                             "/m --frame 3", &out));
     EXPECT_NE(std::string::npos, out.find("--frame")) << out;
+    std::ofstream(dir + "/c.yml.gz") << "not a clone file";
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                            "/m --clones " + dir + "/c.yml.gz", &out));
+    EXPECT_NE(std::string::npos, out.find("--reconstruction")) << out;
     EXPECT_EQ(2, runCommand("env -u DISPLAY -u WAYLAND_DISPLAY " + bin + " --input " + dir +
                             "/frames --masks " + dir + "/m", &out));
     EXPECT_NE(std::string::npos, out.find("DISPLAY")) << out;
