@@ -497,7 +497,7 @@ TEST(Augocc_SilhouetteEditor, accuracy_proposals_synthesized_gt_derived)
 {
     const SyntheticScene& s = synthScene();
     const double kMinMeanIoU = 0.97;   // issue 6: proposed silhouettes, before any correction
-    const double kMinWorstIoU = 0.94;  // no single frame far off (regression guard)
+    const double kMinWorstIoU = 0.95;  // no single frame far off (regression guard)
     const Mat grow = getStructuringElement(MORPH_ELLIPSE, Size(5, 5));
     const Matx23d shift(1, 0, 2, 0, 1, -1);
     std::set<int> keys(s.keyFrames.begin(), s.keyFrames.end());
@@ -558,7 +558,7 @@ TEST(Augocc_SilhouetteEditor, accuracy_proposals_from_clones)
     SceneSynthesizer::create(sp)->synthesize(s);
     Ptr<CloneSet> clones = CloneBuilder::create()->build(s.groundTruth, s.keyFrameMasks);
     const double kMinMeanIoU = 0.97;   // issue 6: proposed silhouettes, non-key frames
-    const double kMinWorstIoU = 0.93;  // per object-frame, regression guard
+    const double kMinWorstIoU = 0.95;  // per object-frame, regression guard
     std::set<int> keys(s.keyFrames.begin(), s.keyFrames.end());
     double sumRaw = 0, sumSnapped = 0, worst = 1;
     int n = 0;
