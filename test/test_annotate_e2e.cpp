@@ -380,3 +380,44 @@ TEST(Augocc_AnnotateE2e, bad_input)
 
 } // namespace
 } // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+
+// --suggest marks (and prints) key frames before the window opens; without a display the tool
+// then stops with exit 2, which lets this test run anywhere.
+TEST(Augocc_AnnotateE2e, suggest_prints_key_frames)
+{
+    SceneSynthesizer::Params sp;
+    sp.frames = 6;
+    sp.numKeyFrames = 2;
+    sp.numTracks = 100;
+    SyntheticScene scene;
+    SceneSynthesizer::create(sp)->synthesize(scene);
+    const std::string dir = tempDir("annotate_suggest");
+    fs::create_directories(dir + "/frames");
+    for (int f = 0; f < sp.frames; ++f)
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scene.frames[f]));
+    writeTracks(dir + "/tracks.yml", scene.tracks);
+    writeReconstruction(dir + "/rec.yml", scene.groundTruth);
+    std::string out;
+    EXPECT_EQ(2, runCommand("env -u DISPLAY -u WAYLAND_DISPLAY " + augoccBinary() +
+                                " annotate --input " + dir + "/frames --masks " + dir + "/m" +
+                                " --tracks " + dir + "/tracks.yml --reconstruction " + dir +
+                                "/rec.yml --suggest 3 --object building",
+                            &out));
+    const size_t at = out.find("suggested key frames for building:");
+    ASSERT_NE(std::string::npos, at) << out;
+    std::istringstream is(out.substr(at + std::string("suggested key frames for building:").size()));
+    std::vector<int> keys(3);
+    is >> keys[0] >> keys[1] >> keys[2];
+    EXPECT_EQ(suggestKeyFrames(scene.tracks, scene.groundTruth, 3), keys) << out;
+    EXPECT_EQ(0, keys.front());
+    EXPECT_EQ(sp.frames - 1, keys.back());
+    fs::remove_all(dir);
+}
+
+} // namespace
+} // namespace opencv_test
