@@ -3,7 +3,7 @@
 
 #include "test_precomp.hpp"
 #include "gl_context.hpp"
-#include "compositor_shading.hpp"
+#include "shading.hpp"
 
 #include <opencv2/highgui.hpp>
 
@@ -63,10 +63,11 @@ Mat makeFrame()
 // The lit colour of the quad per the shading convention, BGR 8-bit.
 Vec3b expectedBgr(const Vec3f& diffuse, const Vec3f& ambient)
 {
-    Material m;
-    m.diffuse = diffuse;
-    m.ambient = ambient;
-    const Vec3f rgb = augocc::detail::shadeColor(m, lightDirection());
+    // base * (ambient + diffuse * max(0, n.L)) with n = L, base white.
+    const float ndotl = lightDirection().dot(lightDirection());
+    Vec3f rgb;
+    for (int k = 0; k < 3; k++)
+        rgb[k] = std::min(1.f, ambient[k] + diffuse[k] * ndotl);
     Vec3b c;
     for (int k = 0; k < 3; k++)
         c[2 - k] = saturate_cast<uchar>(255 * rgb[k]);
@@ -223,17 +224,16 @@ public:
             d.copyTo(depth);
     }
     void save(const String&) const CV_OVERRIDE {}
-    // The rest of the CloneSet interface is not used by the compositor.
     std::vector<int> keyFrames(const String&) const CV_OVERRIDE { return {}; }
     std::vector<int> patchFrames(const String&, int) const CV_OVERRIDE { return {}; }
     int voxelCount(const String&) const CV_OVERRIDE { return 0; }
     int patchVoxelCount(const String&, int) const CV_OVERRIDE { return 0; }
-    Vec3i gridSize(const String&) const CV_OVERRIDE { return Vec3i(); }
-    double voxelSize(const String&) const CV_OVERRIDE { return 0; }
-    void gridPose(const String&, Matx33d& R, Vec3d& o) const CV_OVERRIDE
+    Vec3i gridSize(const String&) const CV_OVERRIDE { return Vec3i(0, 0, 0); }
+    double voxelSize(const String&) const CV_OVERRIDE { return 1.0; }
+    void gridPose(const String&, Matx33d& R, Vec3d& origin) const CV_OVERRIDE
     {
         R = Matx33d::eye();
-        o = Vec3d();
+        origin = Vec3d(0, 0, 0);
     }
     void exportPly(const String&) const CV_OVERRIDE {}
 };

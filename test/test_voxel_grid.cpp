@@ -3,6 +3,7 @@
 
 #include "test_precomp.hpp"
 #include "voxel_grid.hpp"
+#include "clone_codec.hpp"
 
 namespace opencv_test {
 namespace {
@@ -77,7 +78,19 @@ TEST_P(Augocc_VoxelGrid_P, carve_equals_brute_force)
 INSTANTIATE_TEST_SUITE_P(/**/, Augocc_VoxelGrid_P, testing::Values((int)SCALED_ORTHOGRAPHIC,
                                                                     (int)PERSPECTIVE));
 
-TEST(Augocc_VoxelGrid, runs_roundtrip_and_surface)
+TEST(Augocc_VoxelGrid, label_distance_matches_opencv)
+{
+    RNG rng(5);
+    const Mat m = blobMask(Size(200, 150), rng);
+    Mat dk, dc;
+    distanceTransform(m, dk, DIST_C, 3);
+    distanceTransform(m == 0, dc, DIST_C, 3);
+    Mat ref = dk + dc, mine;
+    labelDistance(m).convertTo(mine, CV_32F);
+    EXPECT_MAT_NEAR(mine, ref, 0.0);
+}
+
+TEST(Augocc_VoxelGrid, codec_roundtrip_and_surface)
 {
     VoxelGrid g;
     g.create(Vec3i(20, 30, 40), Matx33d::eye(), Vec3d(0, 0, 0), 0.1, 0);
@@ -86,14 +99,25 @@ TEST(Augocc_VoxelGrid, runs_roundtrip_and_surface)
         for (int j = 4; j < 26; j++)
             for (int i = 2; i < 18; i++)
                 g.data[g.index(i, j, k)] = rng.uniform(0, 10) > 0 ? 1 : 0;
-    const Mat runs = g.encodeRuns();
-    VoxelGrid h = g;
-    h.data.assign(h.data.size(), 0);
-    h.decodeRuns(runs, "test");
-    EXPECT_TRUE(h.data == g.data);
-    Mat bad = runs.clone();
-    bad.at<int>(0) += 1;
-    EXPECT_THROW(h.decodeRuns(bad, "test"), cv::Exception);
+    const std::vector<uchar> bytes = encodeGrid(g.data, g.dims[0], g.dims[1] * g.dims[2]);
+    std::vector<uchar> back;
+    decodeGrid(bytes, g.dims[0], g.dims[1] * g.dims[2], back, "test");
+    EXPECT_TRUE(back == g.data);
+    std::vector<uchar> bad = bytes;
+    bad.pop_back();
+    EXPECT_THROW(decodeGrid(bad, g.dims[0], g.dims[1] * g.dims[2], back, "test"), cv::Exception);
+    // Base64 blobs through FileStorage, every length modulo 3.
+    for (size_t n : {0, 1, 2, 3, 5000, 6001})
+    {
+        std::vector<uchar> blob(n);
+        for (size_t q = 0; q < n; q++)
+            blob[q] = (uchar)(q * 7 + 3);
+        FileStorage w(".yml", FileStorage::WRITE | FileStorage::MEMORY);
+        writeBlob(w, "b", blob);
+        const std::string text = w.releaseAndGetString();
+        FileStorage r(text, FileStorage::READ | FileStorage::MEMORY);
+        EXPECT_TRUE(readBlob(r["b"], "test") == blob) << n;
+    }
 
     // A solid block's surface: all voxels but the interior ones.
     VoxelGrid b;

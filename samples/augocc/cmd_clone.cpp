@@ -1,14 +1,101 @@
-// augocc clone: placeholder until its stage lands (exit 2, "not implemented yet").
+// augocc clone: builds the clones of the real objects (the paper's Section 6) from a reconstruction
+// and key-frame masks. A thin shell over cv::augocc::CloneBuilder.
 
 #include "cli_common.hpp"
 
+#include <sstream>
+#include <opencv2/augocc.hpp>
+
 namespace augocc_cli {
 
-void registerClone(CLI::App& app, Globals&)
+namespace {
+
+struct CloneOptions
 {
-    CLI::App* sub = app.add_subcommand("clone", "(not implemented yet)");
-    sub->allow_extras();
-    sub->callback([]() { throw UsageError("clone: not implemented yet"); });
+    std::string reconstruction, masks, out, tracks, orientation, ply, patchRule = "nearest";
+    double voxelPixels = 1.0;
+    int raysPerPixel = 2;
+    bool noOcclusion = false;
+};
+
+cv::Vec3d parseOrientation(const std::string& text)
+{
+    std::stringstream ss(text);
+    cv::Vec3d v;
+    char c1 = 0, c2 = 0;
+    if (!(ss >> v[0] >> c1 >> v[1] >> c2 >> v[2]) || c1 != ',' || c2 != ',' || !ss.eof())
+        throw UsageError("--orientation " + text + ": expected rx,ry,rz (degrees)");
+    return v * (CV_PI / 180.0);
+}
+
+void runClone(const CloneOptions& o, const Globals& g)
+{
+    using namespace cv::augocc;
+    requireFile("--reconstruction", o.reconstruction);
+    requireFile("--masks", o.masks);
+    if (!o.tracks.empty())
+        requireFile("--tracks", o.tracks);
+    CloneBuilder::Params p;
+    p.voxelPixels = o.voxelPixels;
+    p.raysPerPixel = o.raysPerPixel;
+    p.occlusionAware = !o.noOcclusion;
+    if (o.patchRule == "bracketing")
+        p.patchRule = CloneBuilder::PATCH_BRACKETING;
+    else if (o.patchRule != "nearest")
+        throw UsageError("--patch-rule " + o.patchRule + ": expected nearest or bracketing");
+    if (!o.orientation.empty())
+    {
+        p.orientation = CloneBuilder::ORIENT_USER;
+        p.userRotation = parseOrientation(o.orientation);
+    }
+    const Reconstruction rec = readReconstruction(o.reconstruction);
+    const ObjectMasks masks = readMasks(o.masks, rec.imageSize);
+    if (masks.empty())
+        throw UsageError("--masks " + o.masks + ": no object folder with masks");
+    Tracks tracks;
+    if (!o.tracks.empty())
+        tracks = readTracks(o.tracks);
+    Progress progress(g, "clone", 1);
+    cv::Ptr<CloneSet> clones = CloneBuilder::create(p)->build(rec, masks,
+                                                              o.tracks.empty() ? nullptr : &tracks);
+    progress.finish();
+    clones->save(o.out);
+    if (!o.ply.empty())
+        clones->exportPly(o.ply);
+    for (const cv::String& name : clones->objectNames())
+    {
+        const cv::Vec3i d = clones->gridSize(name);
+        info(g, cv::format("%s: %d voxels in a %dx%dx%d grid, %d key frames", name.c_str(),
+                           clones->voxelCount(name), d[0], d[1], d[2],
+                           (int)clones->keyFrames(name).size()));
+    }
+    info(g, "clones written to " + o.out);
+}
+
+} // namespace
+
+void registerClone(CLI::App& app, Globals& g)
+{
+    auto o = std::make_shared<CloneOptions>();
+    CLI::App* sub = app.add_subcommand("clone", "build the clones of the real objects (voxel "
+                                       "models with patch voxels) from key-frame masks");
+    sub->add_option("--reconstruction", o->reconstruction, "reconstruction.yml")->required();
+    sub->add_option("--masks", o->masks, "MASKS folder: <object>/%04d.png key-frame silhouettes")
+        ->required();
+    sub->add_option("--out", o->out, "clones file to write (.yml.gz)")->required();
+    sub->add_option("--tracks", o->tracks, "tracks.yml the points came from (clusters points by "
+                    "the frames where they are seen)");
+    sub->add_option("--orientation", o->orientation, "box rotation rx,ry,rz in degrees "
+                    "(Rodrigues); default: automatic");
+    sub->add_option("--ply", o->ply, "also write PLY files of each clone and patch set here");
+    sub->add_option("--voxel-pixels", o->voxelPixels, "voxel edge in pixels (default 1)");
+    sub->add_option("--rays-per-pixel", o->raysPerPixel, "patch rays per pixel along each axis "
+                    "(default 2)");
+    sub->add_option("--patch-rule", o->patchRule, "patches for frames between key frames: "
+                    "nearest (default) or bracketing");
+    sub->add_flag("--no-occlusion", o->noOcclusion, "carve under nearer objects' silhouettes too "
+                  "(the paper's rule)");
+    sub->callback([o, &g]() { runClone(*o, g); });
 }
 
 } // namespace augocc_cli

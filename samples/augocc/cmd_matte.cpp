@@ -1,14 +1,48 @@
-// augocc matte: placeholder until its stage lands (exit 2, "not implemented yet").
+// augocc matte: renders every object's clone in every frame of a reconstruction into the
+// contract's MATTES folder, and optionally camera-space depth maps.
 
 #include "cli_common.hpp"
 
+#include <opencv2/augocc.hpp>
+
 namespace augocc_cli {
 
-void registerMatte(CLI::App& app, Globals&)
+namespace {
+
+struct MatteOptions
 {
-    CLI::App* sub = app.add_subcommand("matte", "(not implemented yet)");
-    sub->allow_extras();
-    sub->callback([]() { throw UsageError("matte: not implemented yet"); });
+    std::string reconstruction, clones, out, depth;
+};
+
+void runMatte(const MatteOptions& o, const Globals& g)
+{
+    using namespace cv::augocc;
+    requireFile("--reconstruction", o.reconstruction);
+    requireFile("--clones", o.clones);
+    const Reconstruction rec = readReconstruction(o.reconstruction);
+    const cv::Ptr<CloneSet> clones = CloneSet::load(o.clones);
+    Progress progress(g, "matte", (int)rec.cameras.size());
+    writeMattes(o.out, *clones, rec, o.depth);
+    progress.finish();
+    info(g, cv::format("mattes of %d objects in %d frames written to %s",
+                       (int)clones->objectNames().size(), (int)rec.cameras.size(), o.out.c_str()));
+    if (!o.depth.empty())
+        info(g, "depth maps (32-bit float TIFF, camera-space z, +inf off the clone) written to " +
+                o.depth);
+}
+
+} // namespace
+
+void registerMatte(CLI::App& app, Globals& g)
+{
+    auto o = std::make_shared<MatteOptions>();
+    CLI::App* sub = app.add_subcommand("matte", "render the clones' mattes (and depth) in every "
+                                       "frame");
+    sub->add_option("--reconstruction", o->reconstruction, "reconstruction.yml")->required();
+    sub->add_option("--clones", o->clones, "clones file from augocc clone")->required();
+    sub->add_option("--out", o->out, "MATTES folder to write: <object>/%04d.png")->required();
+    sub->add_option("--depth", o->depth, "also write depth maps here: <object>/%04d.tiff");
+    sub->callback([o, &g]() { runMatte(*o, g); });
 }
 
 } // namespace augocc_cli

@@ -1,14 +1,72 @@
-// augocc sfm: placeholder until its stage lands (exit 2, "not implemented yet").
+// augocc sfm: tracks.yml -> reconstruction.yml (factorization, the paper's 3F+1 refinement,
+// bundle adjustment, model selection), optionally a COLMAP text model and a PLY of the points.
 
 #include "cli_common.hpp"
 
+#include <opencv2/augocc.hpp>
+
 namespace augocc_cli {
 
-void registerSfm(CLI::App& app, Globals&)
+namespace {
+
+struct SfmArgs
 {
-    CLI::App* sub = app.add_subcommand("sfm", "(not implemented yet)");
-    sub->allow_extras();
-    sub->callback([]() { throw UsageError("sfm: not implemented yet"); });
+    std::string tracks, out, model = "auto", colmap, ply;
+    bool noBundle = false;
+};
+
+std::string statsLine(const cv::augocc::ReprojectionStats& s)
+{
+    return cv::format("RMS %.3f px, median %.3f px, p95 %.3f px over %d observations", s.rms,
+                      s.median, s.p95, s.observations);
+}
+
+} // namespace
+
+void registerSfm(CLI::App& app, Globals& g)
+{
+    auto args = std::make_shared<SfmArgs>();
+    CLI::App* sub = app.add_subcommand("sfm", "recover cameras and 3D points from tracks "
+                                       "(Tomasi-Kanade factorization + Ceres refinement)");
+    sub->add_option("--tracks", args->tracks, "tracks.yml (contract)")->required();
+    sub->add_option("--out", args->out, "reconstruction.yml to write")->required();
+    sub->add_option("--model", args->model, "scaled_orthographic | perspective | auto "
+                    "(default auto: perspective only when it lowers the reprojection RMS by "
+                    "more than 10%)");
+    sub->add_option("--colmap", args->colmap, "also write a COLMAP text model into this folder");
+    sub->add_option("--ply", args->ply, "also write the 3D points as a PLY file");
+    sub->add_flag("--no-ba", args->noBundle, "skip the full bundle adjustment (the paper's "
+                  "3F+1 refinement only)");
+    sub->callback([args, &g]() {
+        requireFile("--tracks", args->tracks);
+        if (args->model != "auto" && args->model != "scaled_orthographic" &&
+            args->model != "perspective")
+            throw UsageError("--model " + args->model + ": expected scaled_orthographic, "
+                             "perspective or auto");
+        const cv::augocc::Tracks tracks = cv::augocc::readTracks(args->tracks);
+        cv::augocc::SfmOptions opt;
+        opt.model = args->model;
+        opt.bundleAdjust = !args->noBundle;
+        cv::augocc::SfmReport rep;
+        Progress progress(g, "sfm", 1);
+        const cv::augocc::Reconstruction rec = cv::augocc::recoverCameras(tracks, opt, &rep);
+        progress.finish();
+        cv::augocc::writeReconstruction(args->out, rec);
+        if (!args->colmap.empty())
+            cv::augocc::writeColmapModel(args->colmap, rec, tracks);
+        if (!args->ply.empty())
+            cv::augocc::writePointsPly(args->ply, rec);
+        info(g, cv::format("sfm: %d frames, %d tracks kept, %d rejected; model %s",
+                           (int)rec.cameras.size(), rep.inlierTracks, rep.rejectedTracks,
+                           rep.chosenModel.c_str()));
+        info(g, "  factorization:       " + statsLine(rep.factorization));
+        info(g, "  3F+1 refinement:     " + statsLine(rep.positionZoom));
+        if (opt.bundleAdjust)
+            info(g, "  orthographic BA:     " + statsLine(rep.orthographic));
+        if (rep.perspective.observations > 0)
+            info(g, "  perspective BA:      " + statsLine(rep.perspective));
+        info(g, "wrote " + args->out);
+    });
 }
 
 } // namespace augocc_cli

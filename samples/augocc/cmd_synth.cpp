@@ -29,8 +29,11 @@ struct SynthOptions
     double outliers = 0.0;
     std::string size = "640x480";
     int tracks = 600;
-    int keyFrames = 6;
+    int keyFrames = -1;  // default: min(6, frames)
     double distanceRatio = 10.0;
+    int supersample = 1;
+    double orbit = 50.0;
+    double elevation = 25.0;
     std::string contactSheet;
 };
 
@@ -100,14 +103,16 @@ void writeDepth(const fs::path& dir, const std::vector<Mat>& depth)
         fs << "scale" << scale;
         fs << "description" << "camera-space z = value / scale; 0 = nothing (infinite)";
     }
-    for (size_t f = 0; f < depth.size(); f++)
-    {
-        Mat z = depth[f].clone();
-        z.setTo(0, z == std::numeric_limits<float>::infinity());
-        Mat png;
-        z.convertTo(png, CV_16U, scale);
-        writeImage((dir / format("%04d.png", (int)f)).string(), png);
-    }
+    parallel_for_(Range(0, (int)depth.size()), [&](const Range& r) {
+        for (int f = r.start; f < r.end; f++)
+        {
+            Mat z = depth[f].clone();
+            z.setTo(0, z == std::numeric_limits<float>::infinity());
+            Mat png;
+            z.convertTo(png, CV_16U, scale);
+            writeImage((dir / format("%04d.png", f)).string(), png);
+        }
+    });
 }
 
 Mat contactSheet(const SyntheticScene& scene)
@@ -150,8 +155,11 @@ void runSynth(const Globals& g, const SynthOptions& o)
     p.outlierFraction = o.outliers;
     p.imageSize = parseSize(o.size);
     p.numTracks = o.tracks;
-    p.numKeyFrames = o.keyFrames;
+    p.numKeyFrames = o.keyFrames > 0 ? o.keyFrames : std::min(6, std::max(2, o.frames));
     p.distanceRatio = o.distanceRatio;
+    p.frameSupersample = o.supersample;
+    p.orbitDegrees = o.orbit;
+    p.elevationDegrees = o.elevation;
     Ptr<SceneSynthesizer> synth;
     try
     {
@@ -159,7 +167,18 @@ void runSynth(const Globals& g, const SynthOptions& o)
     }
     catch (const cv::Exception& e)
     {
-        throw UsageError("synth: " + e.err);
+        // Name the flag behind the rejected parameter.
+        static const std::pair<const char*, const char*> kFlags[] = {
+            {"frames", "--frames"}, {"imageSize", "--size"}, {"noiseSigma", "--noise"},
+            {"partialFraction", "--partial"}, {"outlierFraction", "--outliers"},
+            {"numTracks", "--tracks"}, {"numKeyFrames", "--key-frames"},
+            {"distanceRatio", "--distance-ratio"}, {"frameSupersample", "--supersample"},
+            {"orbitDegrees", "--orbit"}, {"elevationDegrees", "--elevation"}};
+        std::string flag;
+        for (const auto& kv : kFlags)
+            if (e.err.find(std::string(kv.first) + " must") != std::string::npos)
+                flag = std::string(kv.second) + ": ";
+        throw UsageError("synth: " + flag + e.err);
     }
 
     info(g, "synthesizing " + std::to_string(p.frames) + " frames (" + o.model + ", seed " +
@@ -176,10 +195,23 @@ void runSynth(const Globals& g, const SynthOptions& o)
     writeAtomically(o.out, [&](const String& tmpPath) {
         const fs::path tmp(tmpPath);
         fs::create_directories(tmp / "frames");
-        for (size_t f = 0; f < scene.frames.size(); f++)
+        fs::create_directories(tmp / "gt" / "labels");
+        // PNG encoding dominates: frames and labels in parallel (each chunk its own files).
+        const int F = (int)scene.frames.size();
+        const int chunk = 8;
+        for (int start = 0; start < F; start += chunk)
         {
-            writeImage((tmp / "frames" / format("%04d.png", (int)f)).string(), scene.frames[f]);
-            progress.update((int)f + 1);
+            const int end = std::min(F, start + chunk);
+            parallel_for_(Range(start, end), [&](const Range& r) {
+                for (int f = r.start; f < r.end; f++)
+                {
+                    writeImage((tmp / "frames" / format("%04d.png", f)).string(),
+                               scene.frames[f]);
+                    writeImage((tmp / "gt" / "labels" / format("%04d.png", f)).string(),
+                               scene.labels[f]);
+                }
+            });
+            progress.update(end);
         }
         writeVideo((tmp / "video.mp4").string(), scene.frames);
         fs::create_directories(tmp / "input");
@@ -191,10 +223,6 @@ void runSynth(const Globals& g, const SynthOptions& o)
         writeTracks((tmp / "tracks.yml").string(), scene.tracks);
         writeTracks((tmp / "gt" / "clean_tracks.yml").string(), scene.cleanTracks);
         writeDepth(tmp / "gt" / "depth", scene.depth);
-        fs::create_directories(tmp / "gt" / "labels");
-        for (size_t f = 0; f < scene.labels.size(); f++)
-            writeImage((tmp / "gt" / "labels" / format("%04d.png", (int)f)).string(),
-                       scene.labels[f]);
         fs::create_directories(tmp / "gt" / "meshes");
         for (size_t i = 0; i < scene.objectNames.size(); i++)
             writeMeshPly((tmp / "gt" / "meshes" / (scene.objectNames[i] + ".ply")).string(),
@@ -207,6 +235,9 @@ void runSynth(const Globals& g, const SynthOptions& o)
         fs << "partial_fraction" << p.partialFraction;
         fs << "outlier_fraction" << p.outlierFraction;
         fs << "distance_ratio" << p.distanceRatio;
+        fs << "frame_supersample" << p.frameSupersample;
+        fs << "orbit_degrees" << p.orbitDegrees;
+        fs << "elevation_degrees" << p.elevationDegrees;
         fs << "objects" << "[";
         for (const String& name : scene.objectNames)
             fs << name;
@@ -248,10 +279,17 @@ void registerSynth(CLI::App& app, Globals& g)
         ->capture_default_str();
     sub->add_option("--size", o->size, "frame size WIDTHxHEIGHT")->capture_default_str();
     sub->add_option("--tracks", o->tracks, "number of tracks")->capture_default_str();
-    sub->add_option("--key-frames", o->keyFrames, "key frames (first and last included)")
-        ->capture_default_str();
+    sub->add_option("--key-frames", o->keyFrames,
+                    "key frames, evenly spaced, first and last included (default min(6, frames))");
     sub->add_option("--distance-ratio", o->distanceRatio,
                     "perspective: camera distance / scene size")->capture_default_str();
+    sub->add_option("--orbit", o->orbit, "azimuth swept by the camera, degrees")
+        ->capture_default_str();
+    sub->add_option("--elevation", o->elevation, "mean camera elevation, degrees")
+        ->capture_default_str();
+    sub->add_option("--supersample", o->supersample,
+                    "render frames K x K times finer and average down (anti-aliased)")
+        ->capture_default_str();
     sub->add_option("--contact-sheet", o->contactSheet,
                     "also write a PNG of 8 frames with the GT silhouettes outlined");
     sub->callback([&g, o]() { runSynth(g, *o); });

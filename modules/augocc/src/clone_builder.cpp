@@ -6,6 +6,8 @@
 #include "precomp.hpp"
 #include "clone_internal.hpp"
 
+#include <climits>
+
 namespace cv {
 namespace augocc {
 
@@ -326,6 +328,59 @@ Box boxFromSilhouettes(const Reconstruction& rec, const FrameMasks& masks, const
         }
     b.valid = true;
     return b;
+}
+
+// The rectangles' intersection is loose; a coarse visual hull carved against generously dilated
+// silhouettes (so that it keeps every coarse voxel the true visual hull touches) bounds the object
+// much more tightly, and with it the voxel count at a given resolution.
+const int kCoarseVoxelsLongAxis = 64;
+
+Box tightenBySilhouettes(const Box& box, const Reconstruction& rec, const FrameMasks& masks)
+{
+    const Vec3d ext = box.hi - box.lo;
+    const double hc = std::max(ext[0], std::max(ext[1], ext[2])) / kCoarseVoxelsLongAxis;
+    if (!(hc > 0))
+        return box;
+    VoxelGrid g;
+    Vec3i dims;
+    for (int a = 0; a < 3; a++)
+        dims[a] = std::max(1, (int)std::ceil(ext[a] / hc)) + 2;
+    g.create(dims, box.R, box.toWorld(box.lo - Vec3d(hc, hc, hc)), hc, 1);
+    std::vector<CarveView> views;
+    for (const auto& fm : masks)
+    {
+        const Camera& cam = rec.camera(fm.first);
+        double zmin = std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 8; c++)
+            zmin = std::min(zmin, cam.depth(box.corner(c)));
+        const double ppu = cam.model == PERSPECTIVE && zmin > 0 ? cam.pixelsPerUnit(zmin)
+                                                                : cam.pixelsPerUnit(1.0);
+        // Footprint pixels lie within 2 * (half extent) + 1 of any point of the voxel.
+        const int r = 2 * (int)std::ceil(0.87 * hc * ppu) + 2;
+        Mat keep;
+        dilate(fm.second, keep, getStructuringElement(MORPH_RECT, Size(2 * r + 1, 2 * r + 1)));
+        views.push_back(g.carveView(cam, keep));
+    }
+    g.carve(views);
+    Vec3i lo(INT_MAX, INT_MAX, INT_MAX), hi(-1, -1, -1);
+    for (int k = 0; k < dims[2]; k++)
+        for (int j = 0; j < dims[1]; j++)
+            for (int i = 0; i < dims[0]; i++)
+                if (g.data[g.index(i, j, k)])
+                {
+                    lo = Vec3i(std::min(lo[0], i), std::min(lo[1], j), std::min(lo[2], k));
+                    hi = Vec3i(std::max(hi[0], i), std::max(hi[1], j), std::max(hi[2], k));
+                }
+    if (hi[0] < 0)
+        return box;  // nothing survived: keep the rectangles' box, carving will tell
+    Box t = box;
+    const Vec3d o = box.lo - Vec3d(hc, hc, hc);
+    for (int a = 0; a < 3; a++)
+    {
+        t.lo[a] = std::max(box.lo[a], o[a] + hc * (lo[a] - 1));
+        t.hi[a] = std::min(box.hi[a], o[a] + hc * (hi[a] + 2));
+    }
+    return t;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -671,6 +726,7 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
                         "silhouettes; box from the silhouettes alone", o.first.c_str(),
                         (int)pts.size()));
             box = boxFromSilhouettes(rec, o.second, R, o.first);
+            box = tightenBySilhouettes(box, rec, o.second);
             centre = box.centre();
         }
         enlargeBox(box, rec, o.second, params_.maxEnlargeIterations);

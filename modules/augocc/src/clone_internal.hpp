@@ -26,7 +26,7 @@ struct ObjectClone
 };
 
 //! The CloneSet implementation shared by the builder, load() and the tests.
-class CloneSetImpl CV_FINAL : public CloneSet
+class CV_EXPORTS CloneSetImpl CV_FINAL : public CloneSet
 {
 public:
     std::map<String, ObjectClone> objects;
@@ -52,8 +52,9 @@ public:
 /** @brief Step 5 for one key frame: the patch voxels that make the clone cover `silhouette`
 exactly (the paper's two-pass algorithm, several rays per pixel). `keep` (silhouette or unknown)
 bounds where patch footprints may fall. */
-std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camera,
-                                     const Mat& silhouette, const Mat& keep, int raysPerPixel);
+CV_EXPORTS std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camera,
+                                                const Mat& silhouette, const Mat& keep,
+                                                int raysPerPixel);
 
 } // namespace detail
 } // namespace augocc

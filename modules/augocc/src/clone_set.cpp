@@ -6,6 +6,7 @@
 
 #include "precomp.hpp"
 #include "clone_internal.hpp"
+#include "clone_codec.hpp"
 
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -330,15 +331,23 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
         CV_Error(Error::StsBadSize, cv::format("clones: render: bad image size %dx%d",
                                                imageSize.width, imageSize.height));
     const VoxelProjector proj = o.grid.projector(camera, imageSize);
-    Mat zmin(imageSize, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
-    splatVoxels(proj, o.surface.ijk.data(), o.surface.faces.data(), o.surface.size(), true, zmin,
-                nullptr);
+    std::vector<VoxelList> lists(1);
+    lists[0].ijk = o.surface.ijk.data();
+    lists[0].faces = o.surface.faces.data();
+    lists[0].n = o.surface.size();
+    lists[0].frontOnly = true;
     for (int kf : patchFrames(object, frame))
     {
         auto it = o.patches.find(kf);
-        if (it != o.patches.end())
-            splatVoxels(proj, it->second.data(), nullptr, it->second.size(), false, zmin, nullptr);
+        if (it == o.patches.end() || it->second.empty())
+            continue;
+        VoxelList l;
+        l.ijk = it->second.data();
+        l.n = it->second.size();
+        lists.push_back(l);
     }
+    Mat zmin;
+    renderDepth(o.grid, proj, lists, zmin);
     if (matte.needed())
     {
         Mat m = zmin < std::numeric_limits<float>::infinity();
@@ -351,7 +360,7 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
 void CloneSetImpl::save(const String& path) const
 {
     writeAtomically(path, [&](const String& tmp) {
-        FileStorage fs(tmp, FileStorage::WRITE | FileStorage::BASE64);
+        FileStorage fs(tmp, FileStorage::WRITE);
         if (!fs.isOpened())
             CV_Error(Error::StsError, path + ": cannot open for writing");
         fs << "format" << "augocc_clones";
@@ -369,7 +378,8 @@ void CloneSetImpl::save(const String& path) const
             fs << "origin" << Mat(o.grid.origin);
             fs << "voxel_size" << o.grid.h;
             fs << "centre" << Mat(o.centre);
-            fs << "runs" << o.grid.encodeRuns();
+            writeBlob(fs, "voxels", encodeGrid(o.grid.data, o.grid.dims[0],
+                                               o.grid.dims[1] * o.grid.dims[2]));
             fs << "key_frames" << "[";
             for (const auto& m : o.masks)
             {
@@ -377,14 +387,22 @@ void CloneSetImpl::save(const String& path) const
                 fs << "frame" << m.first;
                 std::vector<uchar> png;
                 cv::imencode(".png", m.second, png);
-                fs << "mask_png" << Mat(png, true);
+                writeBlob(fs, "mask_png", png);
+                std::vector<uchar> pv;
                 auto p = o.patches.find(m.first);
-                Mat pv;
-                if (p != o.patches.end() && !p->second.empty())
-                    pv = Mat((int)p->second.size(), 1, CV_32S, (void*)p->second.data()).clone();
+                if (p != o.patches.end())
+                {
+                    putVarint(pv, p->second.size());
+                    uint32_t last = 0;
+                    for (uint32_t v : p->second)
+                    {
+                        putVarint(pv, v - last);  // sorted: deltas are small
+                        last = v;
+                    }
+                }
                 else
-                    pv = Mat(0, 1, CV_32S);
-                fs << "patches" << pv;
+                    putVarint(pv, 0);
+                writeBlob(fs, "patches", pv);
                 fs << "}";
             }
             fs << "]";
@@ -446,18 +464,17 @@ Ptr<CloneSet> CloneSet::load(const String& path)
         const String where = path + ": object '" + o.name + "'";
         if (o.name.empty())
             CV_Error(Error::StsParseError, path + ": an object has no 'name'");
-        Mat dims, R, origin, centre, runs;
+        Mat dims, R, origin, centre;
         n["dims"] >> dims;
         n["R_box"] >> R;
         n["origin"] >> origin;
         n["centre"] >> centre;
-        n["runs"] >> runs;
         double h = 0;
         n["voxel_size"] >> h;
         if (dims.total() != 3 || R.rows != 3 || R.cols != 3 || origin.total() != 3 ||
-            centre.total() != 3 || runs.empty() || !(h > 0))
+            centre.total() != 3 || !(h > 0))
             CV_Error(Error::StsParseError, where + ": missing or malformed dims, R_box, origin, "
-                     "centre, voxel_size or runs");
+                     "centre or voxel_size");
         dims.convertTo(dims, CV_32S);
         R.convertTo(R, CV_64F);
         origin.convertTo(origin, CV_64F);
@@ -470,33 +487,34 @@ Ptr<CloneSet> CloneSet::load(const String& path)
         o.grid.origin = Vec3d(origin.ptr<double>());
         o.grid.h = h;
         o.centre = Vec3d(centre.ptr<double>());
-        o.grid.decodeRuns(runs, where);
+        decodeGrid(readBlob(n["voxels"], where + " voxels"), d[0], d[1] * d[2], o.grid.data,
+                   where + " voxels");
         FileNode kfs = n["key_frames"];
         for (FileNodeIterator k = kfs.begin(); k != kfs.end(); ++k)
         {
             int frame = -1;
             (*k)["frame"] >> frame;
-            Mat png, pv;
-            (*k)["mask_png"] >> png;
-            (*k)["patches"] >> pv;
+            const String kw = where + cv::format(" key frame %d", frame);
+            const std::vector<uchar> png = readBlob((*k)["mask_png"], kw + " mask_png");
             Mat mask = png.empty() ? Mat() : cv::imdecode(png, IMREAD_GRAYSCALE);
             if (frame < 0 || mask.empty())
-                CV_Error(Error::StsParseError, where + ": a key frame has no frame or mask");
-            o.masks[frame] = mask;
-            std::vector<uint32_t> p;
-            if (!pv.empty())
+                CV_Error(Error::StsParseError, kw + ": no frame index or no readable mask");
+            o.masks[frame] = mask > 127;
+            const std::vector<uchar> pv = readBlob((*k)["patches"], kw + " patches");
+            size_t pos = 0;
+            const uint64_t count = getVarint(pv, pos, kw + " patches");
+            if (count > (uint64_t)o.grid.total())
+                CV_Error(Error::StsParseError, kw + ": corrupt patches");
+            std::vector<uint32_t> p((size_t)count);
+            uint64_t last = 0;
+            for (size_t q = 0; q < p.size(); q++)
             {
-                if (pv.type() != CV_32SC1)
-                    CV_Error(Error::StsParseError, where + ": patches must be CV_32S");
-                const uint32_t* q = (const uint32_t*)pv.ptr<int>();
-                p.assign(q, q + pv.total());
-                for (uint32_t v : p)
-                {
-                    int i, j, kk;
-                    unpackVoxel(v, i, j, kk);
-                    if (!o.grid.inside(i, j, kk))
-                        CV_Error(Error::StsParseError, where + ": a patch voxel is off the grid");
-                }
+                last += getVarint(pv, pos, kw + " patches");
+                int i, j, kk;
+                unpackVoxel((uint32_t)last, i, j, kk);
+                if (last > 0xffffffffULL || !o.grid.inside(i, j, kk))
+                    CV_Error(Error::StsParseError, kw + ": a patch voxel is off the grid");
+                p[q] = (uint32_t)last;
             }
             o.patches[frame] = p;
         }

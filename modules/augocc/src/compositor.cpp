@@ -8,7 +8,7 @@
 
 #include "precomp.hpp"
 #include "gl_context.hpp"
-#include "compositor_shading.hpp"
+#include "shading.hpp"
 
 #include <map>
 #include <tuple>

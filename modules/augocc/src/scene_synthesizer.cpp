@@ -22,7 +22,7 @@ namespace augocc {
 SceneSynthesizer::Params::Params()
     : frames(60), imageSize(640, 480), model(SCALED_ORTHOGRAPHIC), distanceRatio(10.0),
       orbitDegrees(50.0), elevationDegrees(25.0), numTracks(600), noiseSigma(0.5),
-      partialFraction(0.0), outlierFraction(0.0), numKeyFrames(6), seed(1)
+      partialFraction(0.0), outlierFraction(0.0), numKeyFrames(6), seed(1), frameSupersample(1)
 {
 }
 
@@ -680,6 +680,30 @@ void renderPasses(GlScene& gl, const SceneModel& m, const Camera& cam, Size size
     }
 }
 
+// renderPasses() with the colour rendered `supersample` times finer (supersampledCamera(), from
+// compositor.hpp) and averaged down; labels, depth and silhouettes stay sampled at pixel centres.
+void renderSupersampled(GlScene& gl, const SceneModel& m, const Camera& cam, Size size,
+                        int supersample, const std::vector<const detail::GlMesh*>& extra,
+                        const std::vector<Vec3f>& extraCorners, const PassOutputs& out)
+{
+    if (supersample <= 1 || !out.bgr)
+    {
+        renderPasses(gl, m, cam, size, extra, extraCorners, out);
+        return;
+    }
+    PassOutputs rest = out;
+    rest.bgr = nullptr;
+    if (rest.labels || rest.depth || rest.whole)
+        renderPasses(gl, m, cam, size, extra, extraCorners, rest);
+    Mat fine;
+    PassOutputs colour;
+    colour.bgr = &fine;
+    renderPasses(gl, m, supersampledCamera(cam, supersample),
+                 Size(size.width * supersample, size.height * supersample), extra, extraCorners,
+                 colour);
+    cv::resize(fine, *out.bgr, size, 0, 0, INTER_AREA);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Tracks
 
@@ -915,6 +939,9 @@ public:
         if (p.numKeyFrames < 2 || p.numKeyFrames > p.frames)
             CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: numKeyFrames must be in "
                      "[2, frames = %d] (got %d)", p.frames, p.numKeyFrames));
+        if (p.frameSupersample < 1 || p.frameSupersample > 8)
+            CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: frameSupersample must be "
+                     "in [1, 8] (got %d)", p.frameSupersample));
         std::lock_guard<std::mutex> lock(mutex_);
         p_ = p;
         model_.reset();
@@ -940,7 +967,8 @@ public:
             out.labels = &scene.labels[f];
             out.depth = &scene.depth[f];
             out.whole = &whole[f];
-            renderPasses(gl, m, m.cameras[f], p_.imageSize, {}, {}, out);
+            renderSupersampled(gl, m, m.cameras[f], p_.imageSize, p_.frameSupersample, {}, {},
+                               out);
         }
         // Visible masks from the labels (CPU, parallel over frames: each writes its own masks).
         std::vector<std::vector<Mat>> visible(F, std::vector<Mat>(nObj));
@@ -982,27 +1010,7 @@ public:
                      "[1, 8] (got %d)", supersample));
         const SceneModel& m = model();
         GlScene& gl = glScene();
-        Camera cam = m.cameras[frame];
-        const double k = supersample;
-        // Pixel centres of the fine grid: fine (x + 0.5) = k * (coarse x + 0.5).
-        if (cam.model == SCALED_ORTHOGRAPHIC)
-        {
-            cam.s *= k;
-            cam.pp = Point2d(k * (cam.pp.x + 0.5) - 0.5, k * (cam.pp.y + 0.5) - 0.5);
-        }
-        else
-        {
-            cam.K(0, 0) *= k;
-            cam.K(0, 1) *= k;
-            cam.K(1, 1) *= k;
-            cam.K(0, 2) = k * (cam.K(0, 2) + 0.5) - 0.5;
-            cam.K(1, 2) = k * (cam.K(1, 2) + 0.5) - 0.5;
-        }
-        const Size fine(p_.imageSize.width * supersample, p_.imageSize.height * supersample);
-        if (gl.ctx.size() != fine)
-            gl.ctx.resize(fine);
-        else
-            gl.ctx.makeCurrent();
+        gl.ctx.makeCurrent();  // the virtual meshes' textures are made in this context
         std::vector<std::unique_ptr<detail::GlMesh>> meshes;
         std::vector<const detail::GlMesh*> extra;
         std::vector<Vec3f> corners;
@@ -1021,12 +1029,10 @@ public:
         Mat bgr;
         PassOutputs out;
         out.bgr = &bgr;
-        renderPasses(gl, m, cam, fine, extra, corners, out);
+        renderSupersampled(gl, m, m.cameras[frame], p_.imageSize, supersample, extra, corners,
+                           out);
         meshes.clear();  // textures deleted while the context is current
-        if (supersample > 1)
-            cv::resize(bgr, image, p_.imageSize, 0, 0, INTER_AREA);
-        else
-            bgr.copyTo(image);
+        bgr.copyTo(image);
     }
 
     void renderFrame(int frame, OutputArray image, OutputArray depth, OutputArray labels,
@@ -1046,7 +1052,8 @@ public:
             out.depth = &dep;
         if (wholeMasks.needed())
             out.whole = &whole;
-        renderPasses(gl, m, m.cameras[frame], p_.imageSize, {}, {}, out);
+        renderSupersampled(gl, m, m.cameras[frame], p_.imageSize, p_.frameSupersample, {}, {},
+                           out);
         bgr.copyTo(image);
         if (labels.needed())
             lab.copyTo(labels);

@@ -12,7 +12,7 @@
 
 /*
 The one voxel grid of the module (DESIGN.md): dense, one byte per voxel, a rigid box pose, carving
-against silhouettes, surface extraction, footprint splatting (matte + depth) and run-length I/O.
+against silhouettes, surface extraction and footprint splatting (matte + depth). File encoding: clone_codec.hpp.
 
 Voxel (i, j, k) is the cube of edge h centred at origin + Rbox * (h * (i + 0.5, j + 0.5, k + 0.5)).
 Its FOOTPRINT in an image is the set of pixel centres inside the bounding rectangle of its
@@ -106,9 +106,13 @@ struct CarveView
 {
     VoxelProjector proj;
     Mat keep;   //!< CV_8U, padded
-    Mat dist;   //!< CV_32F, padded, chessboard distance to the other label
+    Mat dist;   //!< CV_8S, padded: +D kept, -D outside, D the chessboard distance to the other
+                //!< label saturated at 127
     int pad = 0;
 };
+
+//! Chessboard distance of every pixel to the nearest pixel of the other label (CV_16U).
+CV_EXPORTS Mat labelDistance(const Mat& label);
 
 class CV_EXPORTS VoxelGrid
 {
@@ -159,23 +163,35 @@ public:
     //! Voxels inside with at least one face on a voxel outside (or on the grid's border).
     SurfaceVoxels surface() const;
 
-    //! Run lengths of the flattened grid, alternating 0-runs and 1-runs, starting with 0 (CV_32S).
-    Mat encodeRuns() const;
-    //! Inverse of encodeRuns(); `dims` must be set. Throws StsParseError on inconsistent runs.
-    void decodeRuns(const Mat& runs, const String& what);
-
     //! Exposed faces of the surface as a mesh in world coordinates (two triangles per face).
     Mesh surfaceMesh(const SurfaceVoxels& s) const;
+    //! Pixel rectangle (clipped to the image) holding every voxel footprint of the grid.
+    Rect imageBounds(const VoxelProjector& proj) const;
     //! Cubes of a list of voxels as a mesh in world coordinates.
     Mesh cubesMesh(const std::vector<uint32_t>& voxels) const;
 };
 
 /** @brief Splats voxel footprints: zmin (CV_32F, +inf initialised by the caller) takes the nearest
-centre depth; zmax (optional) the farthest. With `frontOnly`, voxels with no exposed face turned
-to the camera are skipped (they cannot change the footprint union). `faces` may be null (every
-voxel drawn). */
-CV_EXPORTS void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, size_t n,
-                 bool frontOnly, Mat& zmin, Mat* zmax);
+centre depth; zmax (optional) the farthest. The buffers cover the image from `offset` on. With
+`frontOnly`, voxels with no exposed face turned to the camera are skipped (they cannot change the
+footprint union). `faces` may be null (every voxel drawn). */
+CV_EXPORTS void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces,
+                            size_t n, bool frontOnly, Mat& zmin, Mat* zmax,
+                            Point offset = Point());
+
+//! A list of voxels to render (not owned).
+struct VoxelList
+{
+    const uint32_t* ijk = nullptr;
+    const uchar* faces = nullptr;
+    size_t n = 0;
+    bool frontOnly = false;
+};
+
+/** @brief Nearest depth of the footprints of several voxel lists (CV_32F, +inf elsewhere), in
+parallel over voxel chunks; identical for any thread count. This is the matte/depth renderer. */
+CV_EXPORTS void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
+                            const std::vector<VoxelList>& lists, Mat& zmin);
 
 } // namespace detail
 } // namespace augocc

@@ -4,6 +4,142 @@
 #ifndef OPENCV_AUGOCC_CAMERA_REFINER_HPP
 #define OPENCV_AUGOCC_CAMERA_REFINER_HPP
 
+#include <vector>
 #include <opencv2/core.hpp>
+#include "opencv2/augocc/camera.hpp"
+#include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/factorization_sfm.hpp"
+
+namespace cv {
+namespace augocc {
+
+//! @addtogroup augocc
+//! @{
+
+//! Reprojection statistics over every observation of the kept tracks (pixels).
+struct CV_EXPORTS ReprojectionStats
+{
+    int observations = 0;   //!< observations counted
+    double rms = 0;         //!< sqrt(mean |e|^2), e the 2D reprojection error
+    double median = 0;      //!< median |e|
+    double p95 = 0;         //!< 95th percentile of |e|
+};
+
+/** @brief Reprojection error of a reconstruction against the tracks it came from, over every
+observation whose track has a finite point and whose frame has a camera. */
+CV_EXPORTS ReprojectionStats computeReprojectionStats(const Reconstruction& rec,
+                                                      const Tracks& tracks);
+
+/** @brief Camera refinement with Ceres (Ong, Teh & Tan @cite Ong1998, Section 4, and beyond).
+
+Modes (Params::mode):
+- POSITION_ZOOM (default): exactly the paper's 3F+1 Levenberg-Marquardt. Orientations R_f and
+  the 3D points from the factorization are held fixed; the unknowns are the camera position of
+  every frame (3 per frame) and one zoom s for the whole sequence, minimising the sum of squared
+  reprojection errors. Parameterisation: camera f's position is its translation
+  t_f = (tx, ty, tz) (world to camera, so the centre is -R_f^T t_f); under scaled orthography the
+  image is u = s * (r1 . X + tx) + cx, v = s * (r2 . X + ty) + cy, so tz (the position along the
+  line of sight) does not change the image: it is kept as a parameter of the block but held at
+  its input value (a gauge, set by the factorization to a depth in front of the scene) with a
+  subset manifold. One global s, as in the paper.
+- FULL_BA: scaled-orthographic bundle adjustment: rotations on the quaternion manifold,
+  translations (tx, ty), the zoom (global, or per frame with `perFrameScale`), and the points,
+  under a robust loss. Gauge: the first camera's rotation and the first camera's zoom are held.
+- PERSPECTIVE_BA: the perspective upgrade of an affine solution, a bundle adjustment of the
+  pinhole model written in the "perspective strength" form u = s * Xc.x / (1 + kappa * Xc.z) + cx
+  (Xc relative to a reference depth 1/kappa; f = s / kappa), which is well conditioned near
+  orthography. It starts at kappa = 0, i.e. exactly at the scaled-orthographic solution, and
+  refines rotations, translations, points and kappa (one focal length, fx = fy, principal point
+  at the image centre) under a robust loss. A negative kappa is the depth-reversed twin and is
+  flipped, which resolves the orthographic depth-reversal ambiguity. The output model is
+  PERSPECTIVE; with no measurable perspective the camera ends 1e4 scene radii away.
+
+Ceres runs with num_threads = cv::getNumThreads().
+*/
+class CV_EXPORTS OrthoCameraRefiner : public Algorithm
+{
+public:
+    enum Mode
+    {
+        POSITION_ZOOM = 0,  //!< the paper's 3F+1 LM: positions and one zoom
+        FULL_BA = 1,        //!< scaled-orthographic bundle adjustment
+        PERSPECTIVE_BA = 2  //!< perspective bundle adjustment from the affine solution
+    };
+    enum Loss
+    {
+        LOSS_NONE = 0,      //!< plain least squares
+        LOSS_HUBER = 1,     //!< ceres::HuberLoss(lossScale)
+        LOSS_CAUCHY = 2     //!< ceres::CauchyLoss(lossScale)
+    };
+
+    struct CV_EXPORTS Params
+    {
+        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
+        int mode;                //!< Mode (default POSITION_ZOOM)
+        int loss;                //!< Loss for FULL_BA and PERSPECTIVE_BA (default LOSS_HUBER)
+        double lossScale;        //!< pixels at which the robust loss bends (default 2.0)
+        bool perFrameScale;      //!< FULL_BA: one zoom per frame instead of one (default false)
+        int maxIterations;       //!< Levenberg-Marquardt iterations at most (default 50)
+        double functionTolerance;//!< Ceres function_tolerance (default 1e-9)
+    };
+
+    static Ptr<OrthoCameraRefiner> create(const Params& params);
+    //! Creates an instance with default Params (the paper's 3F+1).
+    static Ptr<OrthoCameraRefiner> create();
+    virtual Params getParams() const = 0;
+    virtual void setParams(const Params& params) = 0;
+
+    /** @brief Refines a reconstruction in place.
+    @param tracks the tracks the reconstruction came from (points rows = track columns).
+    @param rec in: a scaled-orthographic reconstruction (any mode) or a perspective one
+    (PERSPECTIVE_BA mode); out: refined. Points rows that are NaN stay NaN and are not used.
+    @return false (reason logged, `rec` unchanged) when Ceres reports an unusable solution;
+    throws StsBadArg on inconsistent input (sizes, model, no usable observation).
+    */
+    virtual bool refine(const Tracks& tracks, Reconstruction& rec) const = 0;
+};
+
+//! Options of recoverCameras() (the `augocc sfm` pipeline).
+struct CV_EXPORTS SfmOptions
+{
+    /** Output model: "scaled_orthographic", "perspective" or "auto". `auto` fits both and keeps
+    the perspective one only when its reprojection RMS is below autoRatio times the
+    scaled-orthographic one (the two models have about the same number of parameters, so a
+    clear drop of the error is what tells that perspective effects are present). */
+    String model = "auto";
+    bool bundleAdjust = true;      //!< run the full scaled-orthographic BA after the 3F+1
+    double autoRatio = 0.9;        //!< `auto`: the RMS ratio below which perspective is kept
+    FactorizationSfM::Params factorization;
+    OrthoCameraRefiner::Params refiner;  //!< loss and iteration settings shared by the stages
+};
+
+//! What recoverCameras() did.
+struct CV_EXPORTS SfmReport
+{
+    int inlierTracks = 0;             //!< tracks kept (finite points)
+    int rejectedTracks = 0;           //!< tracks rejected as outliers or unusable
+    ReprojectionStats factorization;  //!< after the factorization
+    ReprojectionStats positionZoom;   //!< after the paper's 3F+1
+    ReprojectionStats orthographic;   //!< after the scaled-orthographic BA (if run)
+    ReprojectionStats perspective;    //!< after the perspective BA (if run)
+    String chosenModel;               //!< "scaled_orthographic" or "perspective"
+};
+
+/** @brief Factorization, the paper's 3F+1 refinement, optional full bundle adjustment and model
+selection: what `augocc sfm` and `augocc run` call.
+@param tracks the tracks.
+@param options see SfmOptions.
+@param report optional: what was done and the error after each stage.
+@return the reconstruction (points rows aligned with the track columns).
+Throws cv::Exception on degenerate or bad input, and StsError naming the stage when a stage fails.
+*/
+CV_EXPORTS Reconstruction recoverCameras(const Tracks& tracks,
+                                         const SfmOptions& options = SfmOptions(),
+                                         SfmReport* report = nullptr);
+
+//! @}
+
+} // namespace augocc
+} // namespace cv
 
 #endif

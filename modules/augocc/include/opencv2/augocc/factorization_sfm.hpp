@@ -4,6 +4,84 @@
 #ifndef OPENCV_AUGOCC_FACTORIZATION_SFM_HPP
 #define OPENCV_AUGOCC_FACTORIZATION_SFM_HPP
 
+#include <vector>
 #include <opencv2/core.hpp>
+#include "opencv2/augocc/camera.hpp"
+#include "opencv2/augocc/io.hpp"
+
+namespace cv {
+namespace augocc {
+
+//! @addtogroup augocc
+//! @{
+
+/** @brief Tomasi-Kanade factorization under (scaled) orthography @cite Tomasi1992, as used by
+Ong, Teh & Tan @cite Ong1998 (Section 3), made to survive real tracks.
+
+Steps: registration (per-frame centroid), rank-3 affine factorization, metric upgrade (linear
+least squares for the symmetric L = Q Q^T under the scaled-orthographic constraints
+|i_f|^2 = |j_f|^2, i_f . j_f = 0, with a nearest positive-definite repair), world aligned to the
+first reconstructed frame, one global zoom s (pixels per world unit).
+
+Beyond the paper:
+- missing data: tracks that do not span the sequence are used. The affine factorization is
+  initialised on the largest complete block of frames x tracks, grown by affine triangulation and
+  resection, and then refined by alternation (the ALS baseline of Buchanan & Fitzgibbon
+  @cite Buchanan2005) over every observation;
+- gross outliers: tracks whose RMS residual to the affine fit exceeds a robust threshold are
+  rejected, the fit redone without them, and so on until the set is stable; a rejected track's
+  row in `points` is NaN;
+- degenerate input throws cv::Exception (StsBadArg): fewer than three frames or three distinct
+  views (Ullman; e.g. pure translation with a fixed line of sight), affine rank below 3, fewer
+  than 4 usable tracks, non-finite values other than the NaN pairs of unobserved entries.
+
+Output conventions (CONTRACT.md): scaled-orthographic cameras u = s * (R X + t).x + cx with
+(cx, cy) the image centre; world origin at the centroid of the reconstructed points, world axes
+those of the first reconstructed camera (R = I), world unit chosen so that s = 1 (one world unit
+is one pixel); every camera's t.z is the same positive depth, `depthRatio` times the scene's RMS
+radius, so that depths are positive and consistent between frames (t.z does not change the image
+under orthography). Orthography leaves a depth-reversal ambiguity (the mirror image of the scene
+through the image plane, R_f -> Z R_f Z, X -> Z X with Z = diag(1, 1, -1), projects to the same
+pixels): the images do not decide it and this class returns one of the two; the perspective
+refinement (OrthoCameraRefiner::PERSPECTIVE_BA) resolves it when perspective is measurable.
+*/
+class CV_EXPORTS FactorizationSfM : public Algorithm
+{
+public:
+    struct CV_EXPORTS Params
+    {
+        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
+        int minTrackLength;        //!< tracks seen in fewer frames are not used (default 2)
+        int maxAlternations;       //!< missing data: alternation iterations at most (default 300)
+        double alternationTol;     //!< missing data: stop when RMS improves by less (rel.) (1e-7)
+        bool rejectOutliers;       //!< reject gross-outlier tracks (default true)
+        double outlierThreshold;   //!< floor of the rejection threshold, pixels RMS (default 2.5)
+        double outlierSigmas;      //!< threshold = max(floor, this * robust sigma) (default 4)
+        int maxRejectionRounds;    //!< fit / reject / refit rounds at most (default 8)
+        double depthRatio;         //!< camera t.z = this * RMS radius of the points (default 10)
+    };
+
+    static Ptr<FactorizationSfM> create(const Params& params);
+    //! Creates an instance with default Params.
+    static Ptr<FactorizationSfM> create();
+    virtual Params getParams() const = 0;
+    virtual void setParams(const Params& params) = 0;
+
+    /** @brief Recovers scaled-orthographic cameras and 3D points from tracks.
+    @param tracks F x P tracks (NaN where unobserved), validated.
+    @param out reconstruction: one camera per frame with at least 4 usable observations
+    (frames with fewer are left out), `points` P x 3 with NaN rows for rejected or unusable tracks.
+    @param inliers optional output, P x 1 CV_8U, 1 where the track was used and kept.
+    @return false (reason logged) when the missing-data fit does not connect enough frames and
+    tracks to reconstruct; throws on degenerate or bad input (see the class description).
+    */
+    virtual bool reconstruct(const Tracks& tracks, Reconstruction& out,
+                             OutputArray inliers = noArray()) const = 0;
+};
+
+//! @}
+
+} // namespace augocc
+} // namespace cv
 
 #endif

@@ -4,6 +4,73 @@
 #ifndef OPENCV_AUGOCC_FEATURE_TRACKER_HPP
 #define OPENCV_AUGOCC_FEATURE_TRACKER_HPP
 
+#include <functional>
 #include <opencv2/core.hpp>
+#include "opencv2/augocc/io.hpp"
+
+namespace cv {
+namespace augocc {
+
+//! @addtogroup augocc
+//! @{
+
+/** @brief Feature tracks for the factorization: Shi-Tomasi corners @cite Shi1994 followed by
+pyramidal Lucas-Kanade (OpenCV video module) with a forward-backward check, and re-detection that
+keeps about `maxTracks` live tracks spread over the image.
+
+A track starts where a corner is detected and ends when Lucas-Kanade loses it, when tracking
+back from the new frame does not return within `fbThreshold` pixels of where it started, when
+it leaves the image or enters the exclusion mask. New corners are detected, at least
+`minDistance` pixels from every live track, whenever fewer than `redetectRatio * maxTracks`
+tracks are alive. The output is the contract's tracks matrix: F x P CV_32FC2, NaN where a track
+is not observed; tracks observed in fewer than `minTrackLength` frames are dropped. Results do
+not depend on the number of threads.
+*/
+class CV_EXPORTS FeatureTracker : public Algorithm
+{
+public:
+    struct CV_EXPORTS Params
+    {
+        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
+        int maxTracks;          //!< target number of live tracks (default 1000)
+        double quality;         //!< Shi-Tomasi quality level, relative to the best (0.01)
+        double minDistance;     //!< minimum distance between tracks, pixels (default 8)
+        int blockSize;          //!< Shi-Tomasi gradient window (default 3)
+        Size winSize;           //!< Lucas-Kanade window (default 15 x 15)
+        int levels;             //!< pyramid levels above the base (default 3)
+        double fbThreshold;     //!< forward-backward error above which a track ends, px (1.0)
+        double redetectRatio;   //!< re-detect when live tracks < this * maxTracks (0.9)
+        int minTrackLength;     //!< drop tracks seen in fewer frames (default 3)
+        int border;             //!< tracks closer than this to the image edge end, px (4)
+        Mat exclusionMask;      //!< optional CV_8U frame-size mask, > 127 = no features there
+    };
+
+    static Ptr<FeatureTracker> create(const Params& params);
+    //! Creates a tracker with default Params.
+    static Ptr<FeatureTracker> create();
+    virtual Params getParams() const = 0;
+    virtual void setParams(const Params& params) = 0;
+
+    /** @brief Tracks features through in-memory frames.
+    @param frames BGR CV_8UC3 or grey CV_8UC1 images of one size (at least 2).
+    @param out the tracks (image_size = the frames' size).
+    Throws StsBadArg / StsBadSize on fewer than two frames, mixed sizes or types, or an exclusion
+    mask whose size differs from the frames. */
+    virtual void track(InputArrayOfArrays frames, Tracks& out) const = 0;
+
+    /** @brief Tracks features through a frame source (video, image folder, printf pattern),
+    reading it from its current position to the end.
+    @param source the frames.
+    @param out the tracks.
+    @param progress optional, called after each frame with (frames done, frames expected).
+    */
+    virtual void track(const Ptr<FrameSource>& source, Tracks& out,
+                       const std::function<void(int, int)>& progress = nullptr) const = 0;
+};
+
+//! @}
+
+} // namespace augocc
+} // namespace cv
 
 #endif

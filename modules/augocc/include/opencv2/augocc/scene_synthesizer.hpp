@@ -92,7 +92,7 @@ public:
         Valid ranges (setParams() throws StsBadArg/StsOutOfRange otherwise): frames >= 2, both image
         sides >= 32, distanceRatio >= 1, orbitDegrees in [0, 360], elevationDegrees in (0, 90),
         numTracks >= 1, noiseSigma >= 0, fractions in [0, 1] with partial + outlier <= 1,
-        numKeyFrames in [2, frames]. */
+        numKeyFrames in [2, frames], frameSupersample in [1, 8]. */
         Params();
         int frames;                         //!< number of frames (default 60)
         Size imageSize;                     //!< frame size (default 640x480)
@@ -106,6 +106,10 @@ public:
         double outlierFraction;             //!< fraction of tracks that are gross outliers (default 0)
         int numKeyFrames;                   //!< key frames, evenly spaced, first and last included (default 6)
         uint64 seed;                        //!< random seed (textures, points, noise) (default 1)
+        /** Frames are rendered at this factor and averaged down (INTER_AREA), i.e. anti-aliased
+        like a camera integrating over each pixel; masks, labels and depth are always sampled at
+        pixel centres. 1 = one sample per pixel (default 1, valid [1, 8]). */
+        int frameSupersample;
     };
 
     //! Creates a synthesizer; throws as setParams() does on invalid parameters.
@@ -124,7 +128,8 @@ public:
     @param frame frame index.
     @param virtualObjects meshes in world coordinates.
     @param image output BGR CV_8UC3.
-    @param supersample render at this factor and average down (anti-aliased ground truth).
+    @param supersample render at this factor and average down (anti-aliased ground truth);
+    with no virtual object and supersample == Params::frameSupersample the result is the frame.
     */
     virtual void renderWithVirtual(int frame, const std::vector<Mesh>& virtualObjects,
                                    OutputArray image, int supersample = 1) const = 0;

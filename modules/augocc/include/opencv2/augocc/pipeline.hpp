@@ -1,0 +1,107 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#ifndef OPENCV_AUGOCC_PIPELINE_HPP
+#define OPENCV_AUGOCC_PIPELINE_HPP
+
+#include <functional>
+#include <vector>
+#include <opencv2/core.hpp>
+#include "opencv2/augocc/clone_builder.hpp"
+#include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/mesh.hpp"
+
+/*
+The end-to-end runs behind `augocc composite`, `augocc run` and `augocc demo`, so that the command
+line stays a thin shell: a sequence composited to a video or PNG folder with its optional outputs,
+and the scores of a composite against a synthetic ground truth.
+*/
+
+namespace cv {
+namespace augocc {
+
+//! @addtogroup augocc
+//! @{
+
+//! Progress of a long stage: (done, total).
+typedef std::function<void(int done, int total)> ProgressCallback;
+
+//! Options of compositeSequence().
+struct CV_EXPORTS CompositeOptions
+{
+    int firstFrame = 0;        //!< first frame composited
+    int endFrame = -1;         //!< one past the last frame (-1: the end of the input)
+    int supersample = 3;       //!< Compositor::Params::supersample (1: hard edges)
+    String mattesDir;          //!< if set: the clones' mattes, `DIR/<object>/%04d.png` (contract)
+    /** if set: per frame `DIR/%04d.png`, 16-bit, camera-space z of the nearest surface (clone or
+    virtual) as `(value - 1) / scale + offset`, 0 where nothing; `DIR/depth.yml` holds `scale`
+    and `offset` */
+    String depthDir;
+    String virtualLayerDir;    //!< if set: per frame `DIR/%04d.png`, BGRA, the virtual objects
+    double fps = 0;            //!< output video frame rate (0: the input's)
+    ProgressCallback progress; //!< called after every frame
+};
+
+/** @brief Composites frames [firstFrame, endFrame) of a sequence and writes the result.
+
+@param input a video, an image folder or a printf pattern (FrameSource).
+@param rec the reconstruction: a camera for every composited frame, image size = the frames'.
+@param clones the clones of the real objects.
+@param virtualObjects the virtual meshes, world frame of `rec`.
+@param output a video file (`.mp4`, `.avi`, `.mkv`, `.mov`: H.264 through OpenCV's FFmpeg
+backend, MPEG-4 part 2 when H.264 is unavailable) or a folder for `%04d.png` (frame indices of
+the input).
+@param options frames, optional outputs, progress.
+@return the number of frames written.
+
+Every output is written under a temporary name and renamed when all frames are done, so a failure
+leaves no partial output. Throws (naming the file or argument): StsObjectNotFound / StsParseError
+for an unreadable input, StsOutOfRange for a frame range outside the input, StsBadSize /
+StsBadArg when the reconstruction does not match the input (image size, a frame without a camera,
+cameras beyond the input's end), StsError when an output cannot be written.
+*/
+CV_EXPORTS int compositeSequence(const String& input, const Reconstruction& rec,
+                                 const CloneSet& clones, const std::vector<Mesh>& virtualObjects,
+                                 const String& output,
+                                 const CompositeOptions& options = CompositeOptions());
+
+/** @brief Parses a frame range `a:b` (frames a..b-1), `a:` (a to the end) or `a` (one frame).
+Throws StsBadArg on anything else. @param endFrame -1 for "to the end". */
+CV_EXPORTS void parseFrameRange(const String& text, int& firstFrame, int& endFrame);
+
+//! Scores of a composite against the ground truth (see scoreComposite()).
+struct CV_EXPORTS CompositeScore
+{
+    double fractionWithin = 0;     //!< fraction of pixels whose grey level is within tolerance
+    double boundaryDistance = 0;   //!< mean distance (px) between occlusion boundaries, symmetric
+    double bandError = 0;          //!< mean |colour error| (0-255, per channel) in the band
+    int boundaryPixels = 0;        //!< occlusion-boundary pixels of the ground truth
+    int bandPixels = 0;            //!< pixels of the band
+};
+
+/** @brief Compares one composite with the ground truth.
+
+@param composite the composite, BGR CV_8UC3.
+@param truth the ground truth (e.g. SceneSynthesizer::renderWithVirtual()), BGR CV_8UC3.
+@param visible CV_8U, > 127 where the composite shows the virtual objects (coverage >= 1/2).
+@param visibleTruth CV_8U, > 127 where the virtual objects are visible in the truth.
+@param silhouette CV_8U, > 127 where the virtual objects project (visible or hidden).
+@param greyTolerance grey-level tolerance of fractionWithin (the issue's 8).
+@param bandRadius half-width in pixels of the band around the true occlusion boundary.
+
+The occlusion boundary is the boundary of the visible region that is not the boundary of the
+silhouette: where a real object cuts the virtual one. boundaryDistance averages, over the
+boundary pixels of each side, the distance to the other side's visible boundary (0 when the
+truth has no occlusion boundary and neither has the composite). bandError is measured in the
+pixels within bandRadius of the true occlusion boundary.
+*/
+CV_EXPORTS CompositeScore scoreComposite(InputArray composite, InputArray truth, InputArray visible,
+                                         InputArray visibleTruth, InputArray silhouette,
+                                         int greyTolerance = 8, int bandRadius = 2);
+
+//! @}
+
+} // namespace augocc
+} // namespace cv
+
+#endif

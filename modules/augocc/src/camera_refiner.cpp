@@ -1,0 +1,565 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// Camera refinement with Ceres: the paper's 3F+1 Levenberg-Marquardt (Ong, Teh & Tan 1998,
+// Section 4), a scaled-orthographic bundle adjustment, and a perspective bundle adjustment
+// started from the affine solution; recoverCameras(), the `augocc sfm` pipeline.
+
+#include "precomp.hpp"
+#include "sfm_ceres.hpp"
+#include "sfm_detail.hpp"
+
+#include <thread>
+#include <Eigen/Geometry>
+
+namespace cv {
+namespace augocc {
+
+ReprojectionStats computeReprojectionStats(const Reconstruction& rec, const Tracks& tracks)
+{
+    ReprojectionStats st;
+    if (rec.points.rows != tracks.points())
+        CV_Error(Error::StsBadSize, cv::format("reconstruction has %d points, tracks %d",
+                 rec.points.rows, tracks.points()));
+    std::vector<double> e;
+    double s2 = 0;
+    for (const Camera& cam : rec.cameras)
+    {
+        if (cam.frame < 0 || cam.frame >= tracks.frames())
+            continue;
+        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
+        for (int p = 0; p < tracks.points(); p++)
+        {
+            const double* X = rec.points.ptr<double>(p);
+            if (!std::isfinite(row[p].x) || !std::isfinite(X[0]))
+                continue;
+            const Point2d q = cam.project(Vec3d(X[0], X[1], X[2]));
+            const double d = std::hypot(q.x - row[p].x, q.y - row[p].y);
+            e.push_back(d);
+            s2 += d * d;
+        }
+    }
+    st.observations = (int)e.size();
+    if (e.empty())
+        return st;
+    st.rms = std::sqrt(s2 / e.size());
+    std::sort(e.begin(), e.end());
+    st.median = e[e.size() / 2];
+    st.p95 = e[std::min(e.size() - 1, (size_t)(0.95 * e.size()))];
+    return st;
+}
+
+OrthoCameraRefiner::Params::Params()
+    : mode(POSITION_ZOOM), loss(LOSS_HUBER), lossScale(2.0), perFrameScale(false),
+      maxIterations(50), functionTolerance(1e-9)
+{
+}
+
+namespace {
+
+Eigen::Quaterniond toQuat(const Matx33d& R)
+{
+    Eigen::Matrix3d m;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            m(r, c) = R(r, c);
+    Eigen::Quaterniond q(m);
+    q.normalize();
+    return q;
+}
+
+Matx33d fromQuat(const double* xyzw)
+{
+    Eigen::Quaterniond q(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
+    q.normalize();
+    const Eigen::Matrix3d m = q.toRotationMatrix();
+    Matx33d R;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            R(r, c) = m(r, c);
+    return R;
+}
+
+class OrthoCameraRefinerImpl CV_FINAL : public OrthoCameraRefiner
+{
+public:
+    explicit OrthoCameraRefinerImpl(const Params& p) { setParams(p); }
+
+    Params getParams() const CV_OVERRIDE { return params_; }
+
+    void setParams(const Params& p) CV_OVERRIDE
+    {
+        if (p.mode < POSITION_ZOOM || p.mode > PERSPECTIVE_BA)
+            CV_Error(Error::StsBadArg, cv::format("OrthoCameraRefiner: unknown mode %d", p.mode));
+        if (p.loss < LOSS_NONE || p.loss > LOSS_CAUCHY)
+            CV_Error(Error::StsBadArg, cv::format("OrthoCameraRefiner: unknown loss %d", p.loss));
+        if (!(p.lossScale > 0) || p.maxIterations < 1 || !(p.functionTolerance > 0))
+            CV_Error(Error::StsBadArg, "OrthoCameraRefiner: lossScale and functionTolerance "
+                     "must be positive, maxIterations >= 1");
+        params_ = p;
+    }
+
+    bool refine(const Tracks& tracks, Reconstruction& rec) const CV_OVERRIDE;
+
+private:
+    void fillOptions(ceres::Solver::Options& o, bool bundle = false) const
+    {
+        o.minimizer_type = ceres::TRUST_REGION;
+        o.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+        o.linear_solver_type = ceres::DENSE_SCHUR;
+        o.max_num_iterations = params_.maxIterations;
+        o.function_tolerance = params_.functionTolerance;
+        o.num_threads = std::max(1, std::min(cv::getNumThreads(),
+                                             (int)std::thread::hardware_concurrency()));
+        o.minimizer_progress_to_stdout = false;
+        o.logging_type = ceres::SILENT;
+        if (bundle)
+        {
+            // Bundle adjustment: every camera sees most points, so the reduced camera system
+            // is dense and forming it costs points x cameras^2 blocks (seconds at 100 x 1000);
+            // the implicit Schur complement with conjugate gradients costs one pass over the
+            // observations per CG step.
+            o.linear_solver_type = ceres::ITERATIVE_SCHUR;
+            // JACOBI measured 4x faster than SCHUR_JACOBI here (100 x 1000, same final cost).
+            o.preconditioner_type = ceres::JACOBI;
+            o.use_explicit_schur_complement = false;
+        }
+    }
+
+    ceres::LossFunction* makeLoss() const
+    {
+        switch (params_.loss)
+        {
+        case LOSS_HUBER: return new ceres::HuberLoss(params_.lossScale);
+        case LOSS_CAUCHY: return new ceres::CauchyLoss(params_.lossScale);
+        default: return nullptr;
+        }
+    }
+
+    bool refinePositionZoom(const Tracks& tracks, Reconstruction& rec) const;
+    bool refineOrthoBA(const Tracks& tracks, Reconstruction& rec) const;
+    bool refinePerspective(const Tracks& tracks, Reconstruction& rec, double* cost) const;
+
+    Params params_;
+};
+
+void checkInput(const Tracks& tracks, const Reconstruction& rec)
+{
+    tracks.validate("tracks");
+    if (rec.cameras.empty())
+        CV_Error(Error::StsBadArg, "reconstruction: no camera to refine");
+    if (rec.points.rows != tracks.points() || rec.points.cols != 3 ||
+        rec.points.type() != CV_64F)
+        CV_Error(Error::StsBadSize, cv::format("reconstruction: points must be %d x 3 CV_64F "
+                 "(one row per track), got %d x %d %s", tracks.points(), rec.points.rows,
+                 rec.points.cols, typeToString(rec.points.type()).c_str()));
+    for (const Camera& c : rec.cameras)
+    {
+        if (c.frame < 0 || c.frame >= tracks.frames())
+            CV_Error(Error::StsBadArg, cv::format("reconstruction: camera of frame %d, tracks "
+                     "have %d frames", c.frame, tracks.frames()));
+        if (c.model != rec.model)
+            CV_Error(Error::StsBadArg, "reconstruction: cameras mix camera models");
+    }
+}
+
+bool solverUsable(const ceres::Solver::Summary& summary, const char* what)
+{
+    if (!summary.IsSolutionUsable())
+    {
+        CV_LOG_WARNING(NULL, cv::format("augocc sfm: %s: Ceres solution unusable: %s", what,
+                       summary.message.c_str()));
+        return false;
+    }
+    CV_LOG_INFO(NULL, cv::format("augocc sfm: %s: cost %.6g -> %.6g in %d iterations", what,
+                summary.initial_cost, summary.final_cost,
+                (int)summary.iterations.size()));
+    return true;
+}
+
+bool OrthoCameraRefinerImpl::refinePositionZoom(const Tracks& tracks, Reconstruction& rec) const
+{
+    const int n = (int)rec.cameras.size();
+    std::vector<Vec3d> t(n);
+    double s = 0;
+    for (int i = 0; i < n; i++)
+    {
+        t[i] = rec.cameras[i].t;
+        s += rec.cameras[i].s;
+    }
+    s /= n;
+    ceres::Problem::Options po;
+    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    // tz does not change the image under orthography: held at its input value (a gauge).
+    ceres::SubsetManifold holdZ(3, {2});
+    ceres::ParameterBlockOrdering* ordering = new ceres::ParameterBlockOrdering;
+    int residualBlocks = 0;
+    for (int i = 0; i < n; i++)
+    {
+        const Camera& cam = rec.cameras[i];
+        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
+        std::vector<double> rotated, observed;
+        for (int p = 0; p < tracks.points(); p++)
+        {
+            const double* X = rec.points.ptr<double>(p);
+            if (!std::isfinite(row[p].x) || !std::isfinite(X[0]))
+                continue;
+            const Vec3d Xc = cam.R * Vec3d(X[0], X[1], X[2]);
+            rotated.push_back(Xc[0]);
+            rotated.push_back(Xc[1]);
+            observed.push_back(row[p].x);
+            observed.push_back(row[p].y);
+        }
+        if (observed.empty())
+            continue;
+        const Point2d pp = cam.principalPoint();
+        problem.AddResidualBlock(new detail::PositionZoomCost(std::move(rotated),
+                                 std::move(observed), pp.x, pp.y), nullptr, t[i].val, &s);
+        problem.SetManifold(t[i].val, &holdZ);
+        ordering->AddElementToGroup(t[i].val, 0);
+        residualBlocks++;
+    }
+    if (residualBlocks == 0)
+        CV_Error(Error::StsBadArg, "reconstruction: no observation of a reconstructed point");
+    ordering->AddElementToGroup(&s, 1);
+    ceres::Solver::Options options;
+    fillOptions(options);
+    options.linear_solver_ordering.reset(ordering);
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, &problem, &summary);
+    if (!solverUsable(summary, "3F+1 refinement") || !(s > 0))
+        return false;
+    for (int i = 0; i < n; i++)
+    {
+        rec.cameras[i].t = t[i];
+        rec.cameras[i].s = s;
+    }
+    return true;
+}
+
+bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction& rec) const
+{
+    const int n = (int)rec.cameras.size(), P = tracks.points();
+    std::vector<Eigen::Quaterniond> q(n);
+    std::vector<Vec2d> t(n);
+    std::vector<double> s(n);
+    double sGlobal = 0;
+    for (int i = 0; i < n; i++)
+    {
+        q[i] = toQuat(rec.cameras[i].R);
+        t[i] = Vec2d(rec.cameras[i].t[0], rec.cameras[i].t[1]);
+        s[i] = rec.cameras[i].s;
+        sGlobal += s[i] / n;
+    }
+    Mat X = rec.points.clone();
+    ceres::Problem::Options po;
+    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    ceres::EigenQuaternionManifold quatManifold;
+    std::unique_ptr<ceres::LossFunction> loss(makeLoss());
+    ceres::ParameterBlockOrdering* ordering = new ceres::ParameterBlockOrdering;
+    std::vector<uchar> used(P, 0);
+    for (int i = 0; i < n; i++)
+    {
+        const Camera& cam = rec.cameras[i];
+        const Point2d pp = cam.principalPoint();
+        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
+        double* sBlock = params_.perFrameScale ? &s[i] : &sGlobal;
+        for (int p = 0; p < P; p++)
+        {
+            double* x = X.ptr<double>(p);
+            if (!std::isfinite(row[p].x) || !std::isfinite(x[0]))
+                continue;
+            problem.AddResidualBlock(detail::OrthoReprojectionError::Create(row[p].x, row[p].y,
+                                     pp.x, pp.y), loss.get(), q[i].coeffs().data(), t[i].val,
+                                     sBlock, x);
+            used[p] = 1;
+        }
+        if (problem.HasParameterBlock(q[i].coeffs().data()))
+        {
+            problem.SetManifold(q[i].coeffs().data(), &quatManifold);
+            ordering->AddElementToGroup(q[i].coeffs().data(), 1);
+            ordering->AddElementToGroup(t[i].val, 1);
+            if (params_.perFrameScale)
+                ordering->AddElementToGroup(sBlock, 1);
+        }
+    }
+    if (problem.NumResidualBlocks() == 0)
+        CV_Error(Error::StsBadArg, "reconstruction: no observation of a reconstructed point");
+    // Gauge: the first camera's rotation and the zoom (global, or the first camera's).
+    problem.SetParameterBlockConstant(q[0].coeffs().data());
+    if (params_.perFrameScale)
+        problem.SetParameterBlockConstant(&s[0]);
+    else
+    {
+        ordering->AddElementToGroup(&sGlobal, 1);
+        problem.SetParameterBlockConstant(&sGlobal);
+    }
+    for (int p = 0; p < P; p++)
+        if (used[p])
+            ordering->AddElementToGroup(X.ptr<double>(p), 0);
+    ceres::Solver::Options options;
+    fillOptions(options, true);
+    options.linear_solver_ordering.reset(ordering);
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, &problem, &summary);
+    if (!solverUsable(summary, "scaled-orthographic bundle adjustment"))
+        return false;
+    // Back, with the points re-centred on their centroid (a translation gauge).
+    for (int p = 0; p < P; p++)
+        if (!used[p])
+            X.row(p).setTo(std::numeric_limits<double>::quiet_NaN());
+    Vec3d c;
+    detail::rmsRadius(X, &c);
+    for (int p = 0; p < P; p++)
+        if (used[p])
+            for (int k = 0; k < 3; k++)
+                X.at<double>(p, k) -= c[k];
+    for (int i = 0; i < n; i++)
+    {
+        Camera& cam = rec.cameras[i];
+        cam.R = fromQuat(q[i].coeffs().data());
+        const Vec3d Rc = cam.R * c;
+        cam.t = Vec3d(t[i][0] + Rc[0], t[i][1] + Rc[1], cam.t[2]);
+        cam.s = params_.perFrameScale ? s[i] : sGlobal;
+    }
+    rec.points = X;
+    return true;
+}
+
+// Perspective bundle adjustment in the perspective-strength form (sfm_ceres.hpp): one zoom s
+// at the reference depth, one inverse reference depth kappa, per-frame rotation and translation
+// (t.z relative to the reference depth), points. Started from kappa = 0 (the orthographic
+// solution, or the pinhole input converted), so that the orthographic optimum is the start and
+// the perspective effects pull kappa away from it; a negative kappa at the end is the mirror
+// twin of the solution and is flipped.
+bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruction& rec,
+                                               double* finalCost) const
+{
+    const int n = (int)rec.cameras.size(), P = tracks.points();
+    Vec3d c;
+    const double radius = detail::rmsRadius(rec.points, &c);
+    if (!(radius > 0))
+        CV_Error(Error::StsBadArg, "reconstruction: no finite point to refine");
+    Mat X = rec.points.clone();
+    for (int p = 0; p < P; p++)
+        if (std::isfinite(X.at<double>(p, 0)))
+            for (int k = 0; k < 3; k++)
+                X.at<double>(p, k) -= c[k];
+    std::vector<Eigen::Quaterniond> q(n);
+    std::vector<Vec3d> t(n);
+    double s = 0, kappa = 0;
+    double D0 = 0;
+    if (rec.model == PERSPECTIVE)
+    {
+        const Camera& c0 = rec.cameras[0];
+        D0 = (c0.R * c + c0.t)[2];
+        if (!(D0 > 0))
+            CV_Error(Error::StsBadArg, "reconstruction: the points' centroid is behind the "
+                     "first camera");
+        kappa = 1.0 / D0;
+    }
+    for (int i = 0; i < n; i++)
+    {
+        const Camera& cam = rec.cameras[i];
+        q[i] = toQuat(cam.R);
+        const Vec3d Rc = cam.R * c;
+        if (rec.model == PERSPECTIVE)
+        {
+            t[i] = cam.t + Rc - Vec3d(0, 0, D0);
+            s += 0.5 * (cam.K(0, 0) + cam.K(1, 1)) * kappa / n;
+        }
+        else
+        {
+            t[i] = Vec3d(cam.t[0] + Rc[0], cam.t[1] + Rc[1], 0.0);
+            s += cam.s / n;
+        }
+    }
+    ceres::Problem::Options po;
+    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    ceres::EigenQuaternionManifold quatManifold;
+    std::unique_ptr<ceres::LossFunction> loss(makeLoss());
+    ceres::ParameterBlockOrdering* ordering = new ceres::ParameterBlockOrdering;
+    std::vector<uchar> used(P, 0);
+    for (int i = 0; i < n; i++)
+    {
+        const Camera& cam = rec.cameras[i];
+        const Point2d pp = cam.principalPoint();
+        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
+        for (int p = 0; p < P; p++)
+        {
+            double* x = X.ptr<double>(p);
+            if (!std::isfinite(row[p].x) || !std::isfinite(x[0]))
+                continue;
+            problem.AddResidualBlock(detail::PerspectiveStrengthError::Create(row[p].x,
+                                     row[p].y, pp.x, pp.y), loss.get(), q[i].coeffs().data(),
+                                     t[i].val, &s, &kappa, x);
+            used[p] = 1;
+        }
+        if (problem.HasParameterBlock(q[i].coeffs().data()))
+        {
+            problem.SetManifold(q[i].coeffs().data(), &quatManifold);
+            ordering->AddElementToGroup(q[i].coeffs().data(), 1);
+            ordering->AddElementToGroup(t[i].val, 1);
+        }
+    }
+    if (problem.NumResidualBlocks() == 0)
+        CV_Error(Error::StsBadArg, "reconstruction: no observation of a reconstructed point");
+    ordering->AddElementToGroup(&s, 1);
+    ordering->AddElementToGroup(&kappa, 1);
+    // Gauge (similarity, 7 dof): the first camera's rotation and translation, and the zoom.
+    problem.SetParameterBlockConstant(q[0].coeffs().data());
+    problem.SetParameterBlockConstant(t[0].val);
+    problem.SetParameterBlockConstant(&s);
+    for (int p = 0; p < P; p++)
+        if (used[p])
+            ordering->AddElementToGroup(X.ptr<double>(p), 0);
+    ceres::Solver::Options options;
+    fillOptions(options, true);
+    options.linear_solver_ordering.reset(ordering);
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, &problem, &summary);
+    if (!solverUsable(summary, "perspective bundle adjustment") || !std::isfinite(kappa))
+        return false;
+    if (finalCost)
+        *finalCost = summary.final_cost;
+    const Matx33d Z(1, 0, 0, 0, 1, 0, 0, 0, -1);
+    const bool mirror = kappa < 0;
+    if (mirror)
+        kappa = -kappa;
+    // A camera farther than this many scene radii is orthographic for any practical purpose;
+    // kappa is floored there so that the pinhole stays finite.
+    const double kMaxDistanceRatio = 1e4;
+    if (kappa < 1.0 / (kMaxDistanceRatio * radius))
+    {
+        CV_LOG_INFO(NULL, "augocc sfm: no measurable perspective: the camera is placed at "
+                    "1e4 scene radii");
+        kappa = 1.0 / (kMaxDistanceRatio * radius);
+    }
+    D0 = 1.0 / kappa;
+    const double f = s * D0;
+    for (int p = 0; p < P; p++)
+    {
+        if (!used[p])
+        {
+            X.row(p).setTo(std::numeric_limits<double>::quiet_NaN());
+            continue;
+        }
+        if (mirror)
+            X.at<double>(p, 2) = -X.at<double>(p, 2);
+    }
+    for (int i = 0; i < n; i++)
+    {
+        Camera& cam = rec.cameras[i];
+        const Point2d pp = cam.principalPoint();
+        Matx33d R = fromQuat(q[i].coeffs().data());
+        Vec3d ti = t[i];
+        if (mirror)
+        {
+            R = Z * R * Z;
+            ti[2] = -ti[2];
+        }
+        cam = Camera::perspective(R, ti + Vec3d(0, 0, D0),
+                                  Matx33d(f, 0, pp.x, 0, f, pp.y, 0, 0, 1), cam.frame);
+    }
+    rec.model = PERSPECTIVE;
+    rec.points = X;
+    return true;
+}
+
+bool OrthoCameraRefinerImpl::refine(const Tracks& tracks, Reconstruction& rec) const
+{
+    checkInput(tracks, rec);
+    Reconstruction work = rec;
+    bool ok = false;
+    if (params_.mode == PERSPECTIVE_BA)
+    {
+        ok = refinePerspective(tracks, work, nullptr);
+    }
+    else
+    {
+        if (rec.model != SCALED_ORTHOGRAPHIC)
+            CV_Error(Error::StsBadArg, "OrthoCameraRefiner: POSITION_ZOOM and FULL_BA need a "
+                     "scaled_orthographic reconstruction");
+        ok = params_.mode == POSITION_ZOOM ? refinePositionZoom(tracks, work)
+                                           : refineOrthoBA(tracks, work);
+    }
+    if (!ok)
+        return false;
+    rec = work;
+    return true;
+}
+
+} // namespace
+
+Ptr<OrthoCameraRefiner> OrthoCameraRefiner::create(const Params& params)
+{
+    return makePtr<OrthoCameraRefinerImpl>(params);
+}
+
+Ptr<OrthoCameraRefiner> OrthoCameraRefiner::create()
+{
+    return create(Params());
+}
+
+Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, SfmReport* report)
+{
+    const String model = options.model;
+    if (model != "auto" && model != "scaled_orthographic" && model != "perspective")
+        CV_Error(Error::StsBadArg, "--model " + model + ": expected scaled_orthographic, "
+                 "perspective or auto");
+    SfmReport rep;
+    Reconstruction rec;
+    Mat inliers;
+    if (!FactorizationSfM::create(options.factorization)->reconstruct(tracks, rec, inliers))
+        CV_Error(Error::StsError, "sfm: the factorization could not reconstruct the tracks "
+                 "(too few overlapping tracks between frames; see the log)");
+    rep.inlierTracks = countNonZero(inliers);
+    rep.rejectedTracks = tracks.points() - rep.inlierTracks;
+    rep.factorization = computeReprojectionStats(rec, tracks);
+
+    OrthoCameraRefiner::Params rp = options.refiner;
+    rp.mode = OrthoCameraRefiner::POSITION_ZOOM;
+    if (!OrthoCameraRefiner::create(rp)->refine(tracks, rec))
+        CV_Error(Error::StsError, "sfm: the 3F+1 refinement failed (see the log)");
+    rep.positionZoom = computeReprojectionStats(rec, tracks);
+    rep.orthographic = rep.positionZoom;
+    if (options.bundleAdjust)
+    {
+        rp.mode = OrthoCameraRefiner::FULL_BA;
+        if (!OrthoCameraRefiner::create(rp)->refine(tracks, rec))
+            CV_Error(Error::StsError, "sfm: the scaled-orthographic bundle adjustment failed "
+                     "(see the log)");
+        rep.orthographic = computeReprojectionStats(rec, tracks);
+    }
+    rep.chosenModel = "scaled_orthographic";
+    if (model != "scaled_orthographic")
+    {
+        Reconstruction persp = rec;
+        rp.mode = OrthoCameraRefiner::PERSPECTIVE_BA;
+        const bool ok = OrthoCameraRefiner::create(rp)->refine(tracks, persp);
+        if (!ok && model == "perspective")
+            CV_Error(Error::StsError, "sfm: the perspective bundle adjustment failed (see the "
+                     "log)");
+        if (ok)
+        {
+            rep.perspective = computeReprojectionStats(persp, tracks);
+            if (model == "perspective" ||
+                rep.perspective.rms < options.autoRatio * rep.orthographic.rms)
+            {
+                rec = persp;
+                rep.chosenModel = "perspective";
+            }
+        }
+    }
+    if (report)
+        *report = rep;
+    return rec;
+}
+
+} // namespace augocc
+} // namespace cv

@@ -1,0 +1,244 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// Shi-Tomasi + pyramidal Lucas-Kanade tracking with a forward-backward check (Kalal et al.
+// 2010's criterion) and re-detection, producing the tracks matrix of the factorization.
+
+#include "precomp.hpp"
+
+#include <opencv2/video/tracking.hpp>
+
+namespace cv {
+namespace augocc {
+
+FeatureTracker::Params::Params()
+    : maxTracks(1000), quality(0.01), minDistance(8), blockSize(3), winSize(15, 15), levels(3),
+      fbThreshold(1.0), redetectRatio(0.9), minTrackLength(3), border(4)
+{
+}
+
+namespace {
+
+// One tracking session: frames are fed one at a time.
+class TrackingSession
+{
+public:
+    TrackingSession(const FeatureTracker::Params& p, Size size) : p_(p), size_(size)
+    {
+        if (!p_.exclusionMask.empty())
+        {
+            if (p_.exclusionMask.size() != size)
+                CV_Error(Error::StsBadSize, cv::format("exclusion mask is %dx%d, frames are "
+                         "%dx%d", p_.exclusionMask.cols, p_.exclusionMask.rows, size.width,
+                         size.height));
+            if (p_.exclusionMask.type() != CV_8UC1)
+                CV_Error(Error::StsBadArg, "exclusion mask must be 8-bit single channel");
+            excluded_ = p_.exclusionMask > 127;
+        }
+        criteria_ = TermCriteria(TermCriteria::COUNT | TermCriteria::EPS, 30, 0.01);
+    }
+
+    void addFrame(const Mat& frame)
+    {
+        if (frame.size() != size_)
+            CV_Error(Error::StsBadSize, cv::format("frame %d is %dx%d, the first was %dx%d",
+                     frameIndex_, frame.cols, frame.rows, size_.width, size_.height));
+        Mat gray;
+        if (frame.type() == CV_8UC3)
+            cvtColor(frame, gray, COLOR_BGR2GRAY);
+        else if (frame.type() == CV_8UC1)
+            gray = frame;
+        else
+            CV_Error(Error::StsUnsupportedFormat, cv::format("frame %d has type %s; expected "
+                     "8-bit BGR or grey", frameIndex_, typeToString(frame.type()).c_str()));
+        std::vector<Mat> pyr;
+        buildOpticalFlowPyramid(gray, pyr, p_.winSize, p_.levels, true);
+        if (!live_.empty())
+            trackLive(pyr);
+        if ((int)live_.size() < p_.redetectRatio * p_.maxTracks)
+            detect(gray);
+        prevPyr_ = std::move(pyr);
+        frameIndex_++;
+    }
+
+    Tracks finish() const
+    {
+        std::vector<int> keep;
+        for (int k = 0; k < (int)tracks_.size(); k++)
+            if ((int)tracks_[k].pts.size() >= p_.minTrackLength)
+                keep.push_back(k);
+        Tracks out;
+        out.imageSize = size_;
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        out.tracks = Mat(frameIndex_, (int)keep.size(), CV_32FC2, Scalar::all(nan));
+        for (int c = 0; c < (int)keep.size(); c++)
+        {
+            const TrackRec& t = tracks_[keep[c]];
+            for (size_t i = 0; i < t.pts.size(); i++)
+                out.tracks.at<Point2f>(t.start + (int)i, c) = t.pts[i];
+        }
+        return out;
+    }
+
+    int frames() const { return frameIndex_; }
+
+private:
+    struct TrackRec
+    {
+        int start;
+        std::vector<Point2f> pts;
+    };
+
+    bool usable(const Point2f& q) const
+    {
+        const float b = (float)p_.border;
+        if (!(q.x >= b && q.y >= b && q.x <= size_.width - 1 - b && q.y <= size_.height - 1 - b))
+            return false;
+        return excluded_.empty() || !excluded_.at<uchar>(cvRound(q.y), cvRound(q.x));
+    }
+
+    void trackLive(const std::vector<Mat>& pyr)
+    {
+        std::vector<Point2f> prev(live_.size()), next, back;
+        for (size_t i = 0; i < live_.size(); i++)
+            prev[i] = tracks_[live_[i]].pts.back();
+        std::vector<uchar> st, stBack;
+        std::vector<float> err;
+        calcOpticalFlowPyrLK(prevPyr_, pyr, prev, next, st, err, p_.winSize, p_.levels,
+                             criteria_);
+        back = prev;
+        calcOpticalFlowPyrLK(pyr, prevPyr_, next, back, stBack, err, p_.winSize, p_.levels,
+                             criteria_, OPTFLOW_USE_INITIAL_FLOW);
+        std::vector<int> still;
+        still.reserve(live_.size());
+        const double fb2 = p_.fbThreshold * p_.fbThreshold;
+        for (size_t i = 0; i < live_.size(); i++)
+        {
+            const Point2f d = back[i] - prev[i];
+            if (!st[i] || !stBack[i] || d.dot(d) > fb2 || !usable(next[i]))
+                continue;
+            tracks_[live_[i]].pts.push_back(next[i]);
+            still.push_back(live_[i]);
+        }
+        live_.swap(still);
+    }
+
+    void detect(const Mat& gray)
+    {
+        Mat mask(size_, CV_8U, Scalar(255));
+        if (!excluded_.empty())
+            mask.setTo(0, excluded_);
+        const int b = p_.border;
+        mask.rowRange(0, b).setTo(0);
+        mask.rowRange(size_.height - b, size_.height).setTo(0);
+        mask.colRange(0, b).setTo(0);
+        mask.colRange(size_.width - b, size_.width).setTo(0);
+        const int r = std::max(1, (int)std::ceil(p_.minDistance));
+        for (int k : live_)
+            circle(mask, tracks_[k].pts.back(), r, Scalar(0), FILLED);
+        const int want = p_.maxTracks - (int)live_.size();
+        if (want <= 0)
+            return;
+        std::vector<Point2f> corners;
+        goodFeaturesToTrack(gray, corners, want, p_.quality, p_.minDistance, mask,
+                            p_.blockSize);
+        if (corners.empty())
+            return;
+        // Sub-pixel corner positions: the start of a track is an observation like any other.
+        cornerSubPix(gray, corners, Size(3, 3), Size(-1, -1),
+                     TermCriteria(TermCriteria::COUNT | TermCriteria::EPS, 20, 0.01));
+        for (const Point2f& c : corners)
+        {
+            if (!usable(c))
+                continue;
+            live_.push_back((int)tracks_.size());
+            tracks_.push_back(TrackRec{frameIndex_, {c}});
+        }
+    }
+
+    FeatureTracker::Params p_;
+    Size size_;
+    Mat excluded_;
+    TermCriteria criteria_;
+    std::vector<Mat> prevPyr_;
+    std::vector<TrackRec> tracks_;
+    std::vector<int> live_;
+    int frameIndex_ = 0;
+};
+
+class FeatureTrackerImpl CV_FINAL : public FeatureTracker
+{
+public:
+    explicit FeatureTrackerImpl(const Params& p) { setParams(p); }
+
+    Params getParams() const CV_OVERRIDE { return params_; }
+
+    void setParams(const Params& p) CV_OVERRIDE
+    {
+        if (p.maxTracks < 4)
+            CV_Error(Error::StsBadArg, cv::format("FeatureTracker: maxTracks = %d must be >= 4",
+                     p.maxTracks));
+        if (!(p.quality > 0 && p.quality < 1) || !(p.minDistance >= 0) || p.blockSize < 3)
+            CV_Error(Error::StsBadArg, "FeatureTracker: quality must be in (0, 1), minDistance "
+                     ">= 0, blockSize >= 3");
+        if (p.winSize.width < 5 || p.winSize.height < 5 || p.levels < 0 || p.levels > 8)
+            CV_Error(Error::StsBadArg, "FeatureTracker: winSize must be at least 5x5 and "
+                     "levels in 0..8");
+        if (!(p.fbThreshold > 0) || !(p.redetectRatio > 0 && p.redetectRatio <= 1) ||
+            p.minTrackLength < 1 || p.border < 0)
+            CV_Error(Error::StsBadArg, "FeatureTracker: fbThreshold must be positive, "
+                     "redetectRatio in (0, 1], minTrackLength >= 1, border >= 0");
+        params_ = p;
+    }
+
+    void track(InputArrayOfArrays framesArg, Tracks& out) const CV_OVERRIDE
+    {
+        std::vector<Mat> frames;
+        framesArg.getMatVector(frames);
+        if (frames.size() < 2)
+            CV_Error(Error::StsBadArg, cv::format("FeatureTracker: %d frames; tracking needs "
+                     "at least 2", (int)frames.size()));
+        TrackingSession s(params_, frames[0].size());
+        for (const Mat& f : frames)
+            s.addFrame(f);
+        out = s.finish();
+    }
+
+    void track(const Ptr<FrameSource>& source, Tracks& out,
+               const std::function<void(int, int)>& progress) const CV_OVERRIDE
+    {
+        if (source.empty())
+            CV_Error(Error::StsBadArg, "FeatureTracker: no frame source");
+        TrackingSession s(params_, source->size());
+        const int total = std::max(0, source->count() - source->position());
+        Mat frame;
+        while (source->read(frame))
+        {
+            s.addFrame(frame);
+            if (progress)
+                progress(s.frames(), std::max(total, s.frames()));
+        }
+        if (s.frames() < 2)
+            CV_Error(Error::StsBadArg, cv::format("FeatureTracker: the input has %d frame(s); "
+                     "tracking needs at least 2", s.frames()));
+        out = s.finish();
+    }
+
+private:
+    Params params_;
+};
+
+} // namespace
+
+Ptr<FeatureTracker> FeatureTracker::create(const Params& params)
+{
+    return makePtr<FeatureTrackerImpl>(params);
+}
+
+Ptr<FeatureTracker> FeatureTracker::create()
+{
+    return create(Params());
+}
+
+} // namespace augocc
+} // namespace cv

@@ -1,0 +1,204 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// Exports of a reconstruction beyond the contract: COLMAP text model and a PLY point cloud.
+
+#include "precomp.hpp"
+#include "sfm_detail.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <Eigen/Geometry>
+
+namespace cv {
+namespace augocc {
+
+namespace {
+
+Mat checkColors(InputArray colors, int rows, const char* what)
+{
+    if (colors.empty())
+        return Mat();
+    Mat c = colors.getMat();
+    if (c.type() != CV_8UC3 || (int)c.total() != rows)
+        CV_Error(Error::StsBadArg, cv::format("%s: colors must be %d x 1 CV_8UC3, got %d "
+                 "elements of type %s", what, rows, (int)c.total(),
+                 typeToString(c.type()).c_str()));
+    return c.reshape(3, rows);
+}
+
+void openOrThrow(std::ofstream& out, const String& path)
+{
+    out.open(path);
+    if (!out)
+        CV_Error(Error::StsError, "cannot write " + path);
+    out.precision(17);
+}
+
+void closeOrThrow(std::ofstream& out, const String& path)
+{
+    out.close();
+    if (!out)
+        CV_Error(Error::StsError, "write error on " + path);
+}
+
+} // namespace
+
+void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks& tracks,
+                      InputArray colorsArg, double orthoDistanceRatio)
+{
+    rec.validate("reconstruction");
+    tracks.validate("tracks");
+    if (rec.points.rows != tracks.points())
+        CV_Error(Error::StsBadSize, cv::format("reconstruction has %d points, tracks %d",
+                 rec.points.rows, tracks.points()));
+    if (!(orthoDistanceRatio > 1))
+        CV_Error(Error::StsBadArg, "writeColmapModel: orthoDistanceRatio must be > 1");
+    const Mat colors = checkColors(colorsArg, rec.points.rows, "writeColmapModel");
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec)
+        CV_Error(Error::StsError, "cannot create " + dir + ": " + ec.message());
+    const int P = rec.points.rows;
+    Vec3d c;
+    const double radius = detail::rmsRadius(rec.points, &c);
+    const double D = orthoDistanceRatio * std::max(radius, 1e-9);
+
+    // Pinhole equivalents (COLMAP pixel origin: +0.5).
+    std::vector<Camera> cams;
+    for (const Camera& cam : rec.cameras)
+    {
+        if (cam.model == PERSPECTIVE)
+        {
+            cams.push_back(cam);
+            continue;
+        }
+        const Vec3d Rc = cam.R * c;
+        const double f = cam.s * D;
+        const Point2d pp = cam.principalPoint();
+        cams.push_back(Camera::perspective(cam.R, Vec3d(cam.t[0], cam.t[1], D - Rc[2]),
+                                           Matx33d(f, 0, pp.x, 0, f, pp.y, 0, 0, 1), cam.frame));
+    }
+    // POINT2D_IDX of track p in each image: order of the observed finite points.
+    std::vector<std::vector<std::pair<int, int>>> pointTrack(P);  // (image id, point2d idx)
+    std::vector<double> errSum(P, 0.0);
+
+    writeAtomically(dir + "/images.txt", [&](const String& tmp) {
+        std::ofstream out;
+        openOrThrow(out, tmp);
+        out << "# Image list with two lines of data per image:\n"
+               "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
+               "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
+               "# Written by augocc (frame i -> IMAGE_ID i + 1)\n";
+        for (const Camera& cam : cams)
+        {
+            Eigen::Matrix3d R;
+            for (int r = 0; r < 3; r++)
+                for (int k = 0; k < 3; k++)
+                    R(r, k) = cam.R(r, k);
+            Eigen::Quaterniond q(R);
+            q.normalize();
+            const int id = cam.frame + 1;
+            out << id << ' ' << q.w() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' '
+                << cam.t[0] << ' ' << cam.t[1] << ' ' << cam.t[2] << ' ' << id << ' '
+                << cv::format("%04d.png", cam.frame) << '\n';
+            const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
+            int idx = 0;
+            bool firstPt = true;
+            for (int p = 0; p < P; p++)
+            {
+                if (!std::isfinite(row[p].x))
+                    continue;
+                const double* X = rec.points.ptr<double>(p);
+                const bool has3d = std::isfinite(X[0]);
+                if (!firstPt)
+                    out << ' ';
+                firstPt = false;
+                out << row[p].x + 0.5 << ' ' << row[p].y + 0.5 << ' ' << (has3d ? p + 1 : -1);
+                if (has3d)
+                {
+                    pointTrack[p].emplace_back(id, idx);
+                    const Point2d q2 = cam.project(Vec3d(X[0], X[1], X[2]));
+                    errSum[p] += std::hypot(q2.x - row[p].x, q2.y - row[p].y);
+                }
+                idx++;
+            }
+            out << '\n';
+        }
+        closeOrThrow(out, tmp);
+    });
+    writeAtomically(dir + "/cameras.txt", [&](const String& tmp) {
+        std::ofstream out;
+        openOrThrow(out, tmp);
+        out << "# Camera list with one line of data per camera:\n"
+               "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
+        if (rec.model == SCALED_ORTHOGRAPHIC)
+            out << cv::format("# scaled_orthographic cameras approximated by PINHOLE at %g "
+                              "x the scene's RMS radius\n", orthoDistanceRatio);
+        for (const Camera& cam : cams)
+            out << cam.frame + 1 << " PINHOLE " << rec.imageSize.width << ' '
+                << rec.imageSize.height << ' ' << cam.K(0, 0) << ' ' << cam.K(1, 1) << ' '
+                << cam.K(0, 2) + 0.5 << ' ' << cam.K(1, 2) + 0.5 << '\n';
+        closeOrThrow(out, tmp);
+    });
+    writeAtomically(dir + "/points3D.txt", [&](const String& tmp) {
+        std::ofstream out;
+        openOrThrow(out, tmp);
+        out << "# 3D point list with one line of data per point:\n"
+               "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n";
+        for (int p = 0; p < P; p++)
+        {
+            const double* X = rec.points.ptr<double>(p);
+            if (!std::isfinite(X[0]) || pointTrack[p].empty())
+                continue;
+            Vec3b bgr(128, 128, 128);
+            if (!colors.empty())
+                bgr = colors.at<Vec3b>(p);
+            out << p + 1 << ' ' << X[0] << ' ' << X[1] << ' ' << X[2] << ' ' << (int)bgr[2]
+                << ' ' << (int)bgr[1] << ' ' << (int)bgr[0] << ' '
+                << errSum[p] / pointTrack[p].size();
+            for (const auto& tr : pointTrack[p])
+                out << ' ' << tr.first << ' ' << tr.second;
+            out << '\n';
+        }
+        closeOrThrow(out, tmp);
+    });
+}
+
+void writePointsPly(const String& path, const Reconstruction& rec, InputArray colorsArg)
+{
+    if (rec.points.empty() || rec.points.cols != 3 || rec.points.type() != CV_64F)
+        CV_Error(Error::StsBadArg, "writePointsPly: reconstruction points must be P x 3 "
+                 "CV_64F");
+    const Mat colors = checkColors(colorsArg, rec.points.rows, "writePointsPly");
+    int n = 0;
+    for (int p = 0; p < rec.points.rows; p++)
+        n += std::isfinite(rec.points.at<double>(p, 0)) ? 1 : 0;
+    writeAtomically(path, [&](const String& tmp) {
+        std::ofstream out;
+        openOrThrow(out, tmp);
+        out << "ply\nformat ascii 1.0\ncomment augocc reconstruction points\n"
+            << "element vertex " << n << "\nproperty double x\nproperty double y\n"
+            << "property double z\n";
+        if (!colors.empty())
+            out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+        out << "end_header\n";
+        for (int p = 0; p < rec.points.rows; p++)
+        {
+            const double* X = rec.points.ptr<double>(p);
+            if (!std::isfinite(X[0]))
+                continue;
+            out << X[0] << ' ' << X[1] << ' ' << X[2];
+            if (!colors.empty())
+            {
+                const Vec3b bgr = colors.at<Vec3b>(p);
+                out << ' ' << (int)bgr[2] << ' ' << (int)bgr[1] << ' ' << (int)bgr[0];
+            }
+            out << '\n';
+        }
+        closeOrThrow(out, tmp);
+    });
+}
+
+} // namespace augocc
+} // namespace cv

@@ -1,0 +1,188 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#include "perf_precomp.hpp"
+#include "clone_internal.hpp"
+
+#include <cstdio>
+#include <unistd.h>
+
+namespace {
+
+using namespace cv;
+using namespace cv::augocc;
+using namespace cv::augocc::detail;
+
+// A 256^3 problem at 640x480: an object (a box with a dome-like stack of boxes on it) whose grid is
+// about 256 voxels a side at one pixel per voxel, seen by 8 scaled-orthographic key frames.
+struct CloneProblem
+{
+    Reconstruction rec;
+    ObjectMasks masks;
+    std::vector<Mat> keep;
+    VoxelGrid grid;
+    Ptr<CloneSet> clones;
+};
+
+Camera orbit(double azDeg, double elDeg, int frame)
+{
+    const double a = azDeg * CV_PI / 180, e = elDeg * CV_PI / 180;
+    const Vec3d C(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
+    const Vec3d f = -C;
+    Vec3d x = f.cross(Vec3d(0, 1, 0));
+    x /= cv::norm(x);
+    const Vec3d y = f.cross(x);
+    const Matx33d R(x[0], x[1], x[2], y[0], y[1], y[2], f[0], f[1], f[2]);
+    return Camera::orthographic(R, -(R * (C * 50.0)), 1.0, Point2d(319.5, 239.5), frame);
+}
+
+Mat silhouette(const Camera& cam, const std::vector<std::pair<Vec3d, Vec3d> >& boxes)
+{
+    Mat m(480, 640, CV_8U, Scalar(0));
+    for (const auto& b : boxes)
+    {
+        std::vector<Point> c, hull;
+        for (int q = 0; q < 8; q++)
+        {
+            const Point2d p = cam.project(Vec3d(q & 1 ? b.second[0] : b.first[0],
+                                                q & 2 ? b.second[1] : b.first[1],
+                                                q & 4 ? b.second[2] : b.first[2]));
+            c.push_back(Point(cvRound(p.x * 256), cvRound(p.y * 256)));
+        }
+        convexHull(c, hull);
+        fillConvexPoly(m, hull, Scalar(255), LINE_8, 8);
+    }
+    return m;
+}
+
+const CloneProblem& problem()
+{
+    static CloneProblem p;
+    if (!p.keep.empty())
+        return p;
+    // Units are pixels (s = 1): a 150 x 150 x 150 block with a 90-wide tower on top; its box is
+    // about 250 on the long axis once enlarged, so the grid is about 256^3.
+    const std::vector<std::pair<Vec3d, Vec3d> > boxes = {
+        {Vec3d(-75, -125, -75), Vec3d(75, 25, 75)}, {Vec3d(-45, 25, -45), Vec3d(45, 125, 45)}};
+    p.rec.model = SCALED_ORTHOGRAPHIC;
+    p.rec.imageSize = Size(640, 480);
+    for (int f = 0; f < 8; f++)
+    {
+        p.rec.cameras.push_back(orbit(-35 + 10 * f, 20 + 3 * (f % 3), f));
+        p.masks["block"][f] = silhouette(p.rec.cameras.back(), boxes);
+        p.keep.push_back(p.masks["block"][f]);
+    }
+    p.grid.create(Vec3i(256, 256, 256), Matx33d::eye(), Vec3d(-128, -128, -128), 1.0, 1);
+    // The 256^3 clone itself (carved, with patches) for the render and I/O benchmarks.
+    Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
+    ObjectClone& o = set->objects["block"];
+    o.name = "block";
+    o.grid = p.grid;
+    o.centre = Vec3d(0, 0, 0);
+    std::vector<CarveView> views;
+    for (int f = 0; f < 8; f++)
+    {
+        views.push_back(o.grid.carveView(p.rec.cameras[f], p.keep[f]));
+        o.masks[f] = p.keep[f];
+    }
+    o.grid.carve(views);
+    o.surface = o.grid.surface();
+    for (int f = 0; f < 8; f++)
+        o.patches[f] = computePatches(o, p.rec.cameras[f], p.keep[f], p.keep[f], 2);
+    p.clones = set;
+    return p;
+}
+
+void Augocc_CloneBuilder_carve(benchmark::State& state)
+{
+    const CloneProblem& p = problem();
+    VoxelGrid g = p.grid;
+    for (auto _ : state)
+    {
+        state.PauseTiming();
+        std::fill(g.data.begin(), g.data.end(), (uchar)1);
+        state.ResumeTiming();
+        std::vector<CarveView> views(p.rec.cameras.size());
+        parallel_for_(Range(0, (int)views.size()), [&](const Range& r) {
+            for (int q = r.start; q < r.end; q++)
+                views[q] = g.carveView(p.rec.cameras[q], p.keep[q]);
+        });
+        g.carve(views);
+        benchmark::DoNotOptimize(g.data.data());
+    }
+    state.counters["voxels_in"] = (double)g.count();
+    state.counters["bytes_per_voxel"] = (double)(g.data.size() * sizeof(uchar)) / g.total();
+}
+BENCHMARK(Augocc_CloneBuilder_carve)->Name("Augocc_CloneBuilder/carve_256_8views_640x480")
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void Augocc_CloneBuilder_patches(benchmark::State& state)
+{
+    const CloneProblem& p = problem();
+    const CloneSetImpl& set = dynamic_cast<const CloneSetImpl&>(*p.clones);
+    const ObjectClone& obj = set.objects.at("block");
+    const int f = 3;
+    size_t n = 0;
+    for (auto _ : state)
+    {
+        std::vector<uint32_t> v = computePatches(obj, p.rec.cameras[f], p.keep[f], p.keep[f], 2);
+        n = v.size();
+        benchmark::DoNotOptimize(v.data());
+    }
+    state.counters["patch_voxels"] = (double)n;
+    state.counters["grid_voxels"] = (double)obj.grid.total();
+}
+BENCHMARK(Augocc_CloneBuilder_patches)->Name("Augocc_CloneBuilder/patches_one_key_frame")
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void Augocc_CloneSet_render(benchmark::State& state)
+{
+    const CloneProblem& p = problem();
+    // A frame between two key frames.
+    const Camera cam = orbit(-12, 24, 2);
+    Mat matte, depth;
+    for (auto _ : state)
+    {
+        p.clones->render("block", 2, cam, p.rec.imageSize, matte, depth);
+        benchmark::DoNotOptimize(matte.data);
+    }
+    if (countNonZero(matte) == 0)
+        state.SkipWithError("empty matte");
+    const CloneSetImpl& set = dynamic_cast<const CloneSetImpl&>(*p.clones);
+    state.counters["surface_voxels"] = (double)set.objects.at("block").surface.size();
+}
+BENCHMARK(Augocc_CloneSet_render)->Name("Augocc_CloneSet/render_matte_depth_640x480")
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+std::string tmpPath(const char* name)
+{
+    return cv::format("/tmp/augocc_perf_%d_%s", (int)getpid(), name);
+}
+
+void Augocc_CloneSet_save(benchmark::State& state)
+{
+    const CloneProblem& p = problem();
+    const std::string path = tmpPath("clones.yml.gz");
+    for (auto _ : state)
+        p.clones->save(path);
+    std::remove(path.c_str());
+}
+BENCHMARK(Augocc_CloneSet_save)->Name("Augocc_CloneSet/save_256")
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void Augocc_CloneSet_load(benchmark::State& state)
+{
+    const CloneProblem& p = problem();
+    const std::string path = tmpPath("clones_load.yml.gz");
+    p.clones->save(path);
+    for (auto _ : state)
+    {
+        Ptr<CloneSet> c = CloneSet::load(path);
+        benchmark::DoNotOptimize(c.get());
+    }
+    std::remove(path.c_str());
+}
+BENCHMARK(Augocc_CloneSet_load)->Name("Augocc_CloneSet/load_256")
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+} // namespace

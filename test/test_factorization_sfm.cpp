@@ -1,0 +1,294 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#include "test_precomp.hpp"
+#include "sfm_test_utils.hpp"
+#include "sfm_detail.hpp"
+
+namespace opencv_test {
+namespace {
+
+using namespace cv;
+using namespace cv::augocc;
+
+// Noise-free full tracks: exact up to the float32 storage of tracks.yml (~1e-5 px on coordinates
+// of a few hundred pixels, i.e. ~1e-6 deg over the scene); 1e-4 deg is far below any
+// noise-driven error (0.01 deg and more at 0.5 px).
+const double kExactRotDeg = 1e-4;
+// Noisy full tracks (0.5 px, 600 tracks, 60 frames): the factorization alone (before any
+// refinement) lands within a few hundredths of a degree; 0.1 deg is the target after
+// refinement, so the factorization must already meet it.
+const double kFactorizationRotDeg = 0.1;
+// Missing data (40% partial tracks): same target as the partial-track case.
+const double kPartialRotDeg = 0.15;
+
+Tracks makeTracks(int F, int P)
+{
+    Tracks t;
+    t.imageSize = Size(640, 480);
+    t.tracks = Mat(F, P, CV_32FC2, Scalar::all(100));
+    return t;
+}
+
+TEST(Augocc_FactorizationSfM, can_create_default)
+{
+    Ptr<FactorizationSfM> sfm = FactorizationSfM::create();
+    ASSERT_FALSE(sfm.empty());
+    EXPECT_EQ(2, sfm->getParams().minTrackLength);
+}
+
+TEST(Augocc_FactorizationSfM, accuracy_noise_free_exact)
+{
+    SfmProblemParams prm;
+    prm.noiseSigma = 0;
+    prm.frames = 20;
+    prm.points = 100;
+    const SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction rec;
+    ASSERT_TRUE(FactorizationSfM::create()->reconstruct(pb.tracks, rec));
+    ASSERT_EQ(20u, rec.cameras.size());
+    EXPECT_NO_THROW(rec.validate());
+    const CameraComparison c = compareCameras(rec, pb.groundTruth);
+    EXPECT_LT(c.maxRotationDeg, kExactRotDeg);
+    EXPECT_MAT_NEAR(rec.cameras[0].R, Matx33d::eye(), 1e-12);
+    // Noise-free: every observation reprojects to rounding (float tracks: 1e-4 px).
+    const ReprojectionStats st = computeReprojectionStats(rec, pb.tracks);
+    EXPECT_LT(st.rms, 1e-3);
+}
+
+TEST(Augocc_FactorizationSfM, accuracy_full_tracks_noise)
+{
+    SfmProblemParams prm;
+    const SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction rec;
+    Mat inliers;
+    ASSERT_TRUE(FactorizationSfM::create()->reconstruct(pb.tracks, rec, inliers));
+    const CameraComparison c = compareCameras(rec, pb.groundTruth);
+    EXPECT_LT(c.meanRotationDeg, kFactorizationRotDeg);
+    // No outlier in the data: at most a handful of tracks may fall past the 4-sigma threshold.
+    EXPECT_GE(countNonZero(inliers), prm.points - 3);
+}
+
+TEST(Augocc_FactorizationSfM, accuracy_missing_data)
+{
+    SfmProblemParams prm;
+    prm.partialFraction = 0.4;
+    const SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction rec;
+    Mat inliers;
+    ASSERT_TRUE(FactorizationSfM::create()->reconstruct(pb.tracks, rec, inliers));
+    EXPECT_EQ(prm.frames, (int)rec.cameras.size());
+    const CameraComparison c = compareCameras(rec, pb.groundTruth);
+    EXPECT_LT(c.meanRotationDeg, kPartialRotDeg);
+}
+
+TEST(Augocc_FactorizationSfM, accuracy_mostly_missing)
+{
+    // No track spans the sequence: 50% of the matrix missing, every track partial.
+    SfmProblemParams prm;
+    prm.partialFraction = 1.0;
+    prm.missingFraction = 0.5;
+    prm.points = 400;
+    const SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction rec;
+    ASSERT_TRUE(FactorizationSfM::create()->reconstruct(pb.tracks, rec));
+    EXPECT_EQ(prm.frames, (int)rec.cameras.size());
+    const CameraComparison c = compareCameras(rec, pb.groundTruth);
+    EXPECT_LT(c.meanRotationDeg, kPartialRotDeg);
+}
+
+TEST(Augocc_FactorizationSfM, accuracy_outliers)
+{
+    SfmProblemParams prm;
+    prm.partialFraction = 0.4;
+    prm.outlierFraction = 0.05;
+    const SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction rec;
+    Mat inliers;
+    ASSERT_TRUE(FactorizationSfM::create()->reconstruct(pb.tracks, rec, inliers));
+    int nOut = 0, outRejected = 0, nGood = 0, goodKept = 0;
+    for (int p = 0; p < prm.points; p++)
+    {
+        if (pb.outlier[p])
+        {
+            nOut++;
+            outRejected += inliers.at<uchar>(p) == 0;
+            EXPECT_EQ(inliers.at<uchar>(p) == 0, std::isnan(rec.points.at<double>(p, 0)));
+        }
+        else
+        {
+            nGood++;
+            goodKept += inliers.at<uchar>(p);
+        }
+    }
+    ASSERT_GT(nOut, 0);
+    // The targets: >= 95% of outlier tracks rejected, >= 90% of good tracks kept.
+    EXPECT_GE(outRejected, 0.95 * nOut);
+    EXPECT_GE(goodKept, 0.90 * nGood);
+    const CameraComparison c = compareCameras(rec, pb.groundTruth);
+    EXPECT_LT(c.meanRotationDeg, kPartialRotDeg);
+}
+
+TEST(Augocc_FactorizationSfM, metric_upgrade_recovers_rotation_rows)
+{
+    // A = M Q^-1 with M stacked orthonormal rows: the upgrade must give Q up to a rotation,
+    // i.e. A Q has orthonormal rows.
+    RNG rng(7);
+    const int F = 10;
+    Mat A(F, 6, CV_64F);
+    const Matx33d Qtrue(2, 0.3, -0.1, 0.2, 1.5, 0.4, -0.3, 0.1, 0.7);
+    const Matx33d Qi = Qtrue.inv();
+    for (int f = 0; f < F; f++)
+    {
+        const Matx33d R = rotationFromRodrigues(Vec3d(rng.uniform(-1.0, 1.0),
+                                                      rng.uniform(-1.0, 1.0),
+                                                      rng.uniform(-1.0, 1.0)));
+        const Matx33d Ra = R * Qi;
+        for (int k = 0; k < 3; k++)
+        {
+            A.at<double>(f, k) = Ra(0, k);
+            A.at<double>(f, 3 + k) = Ra(1, k);
+        }
+    }
+    Matx33d Q;
+    cv::augocc::detail::metricUpgrade(A, std::vector<uchar>(F, 1), Q);
+    for (int f = 0; f < F; f++)
+    {
+        const double* a = A.ptr<double>(f);
+        const Vec3d i = Q.t() * Vec3d(a[0], a[1], a[2]), j = Q.t() * Vec3d(a[3], a[4], a[5]);
+        EXPECT_NEAR(1.0, cv::norm(i), 1e-9);
+        EXPECT_NEAR(1.0, cv::norm(j), 1e-9);
+        EXPECT_NEAR(0.0, i.dot(j), 1e-9);
+    }
+}
+
+TEST(Augocc_FactorizationSfM, bad_arg_too_few_frames)
+{
+    SfmProblemParams prm;
+    prm.frames = 2;
+    prm.points = 50;
+    const SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction rec;
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(pb.tracks, rec), cv::Exception);
+}
+
+TEST(Augocc_FactorizationSfM, bad_arg_pure_translation)
+{
+    // The camera slides sideways without turning: one line of sight, rank 2.
+    SfmProblemParams prm;
+    prm.frames = 20;
+    prm.points = 100;
+    prm.orbitDegrees = 0;
+    SfmProblem pb = makeSfmProblem(prm);
+    for (int f = 0; f < prm.frames; f++)
+        for (int p = 0; p < prm.points; p++)
+            pb.tracks.tracks.at<Point2f>(f, p) += Point2f(2.0f * f, -1.0f * f);
+    Reconstruction rec;
+    try
+    {
+        FactorizationSfM::create()->reconstruct(pb.tracks, rec);
+        ADD_FAILURE() << "pure translation must throw";
+    }
+    catch (const cv::Exception& e)
+    {
+        EXPECT_EQ(Error::StsBadArg, e.code);
+        EXPECT_NE(std::string::npos, e.err.find("three distinct views")) << e.err;
+    }
+}
+
+TEST(Augocc_FactorizationSfM, bad_arg_two_distinct_views)
+{
+    // Many frames, but only two viewpoints: the metric upgrade is not determined (Ullman).
+    SfmProblemParams prm;
+    prm.frames = 2;
+    prm.points = 100;
+    prm.noiseSigma = 0;
+    const SfmProblem two = makeSfmProblem(prm);
+    Tracks t = makeTracks(10, prm.points);
+    for (int f = 0; f < 10; f++)
+        two.tracks.tracks.row(f % 2).copyTo(t.tracks.row(f));
+    Reconstruction rec;
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
+}
+
+TEST(Augocc_FactorizationSfM, bad_arg_planar_rank)
+{
+    // Points on a line: rank 1 structure, below 3.
+    SfmProblemParams prm;
+    prm.frames = 10;
+    prm.points = 50;
+    SfmProblem pb = makeSfmProblem(prm);
+    Tracks t = pb.tracks;
+    for (int f = 0; f < prm.frames; f++)
+        for (int p = 0; p < prm.points; p++)
+        {
+            const double a = p / 50.0;
+            t.tracks.at<Point2f>(f, p) = Point2f((float)(100 + 200 * a + f),
+                                                 (float)(100 + 50 * a * (1 + 0.01 * f)));
+        }
+    Reconstruction rec;
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
+}
+
+TEST(Augocc_FactorizationSfM, bad_arg_too_few_tracks)
+{
+    SfmProblemParams prm;
+    prm.points = 3;
+    prm.frames = 10;
+    const SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction rec;
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(pb.tracks, rec), cv::Exception);
+    // Enough columns but too few seen twice.
+    Tracks t = makeTracks(10, 6);
+    t.tracks.setTo(Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    for (int p = 0; p < 6; p++)
+        t.tracks.at<Point2f>(p % 10, p) = Point2f(10, 10);
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
+}
+
+TEST(Augocc_FactorizationSfM, bad_arg_non_finite)
+{
+    SfmProblemParams prm;
+    prm.frames = 10;
+    prm.points = 50;
+    SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction rec;
+    Tracks t = pb.tracks;
+    t.tracks.at<Point2f>(3, 4) = Point2f(std::numeric_limits<float>::infinity(),
+                                         std::numeric_limits<float>::infinity());
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
+    t.tracks = pb.tracks.tracks.clone();
+    t.tracks.at<Point2f>(3, 4).x = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
+    // Wrong type.
+    t.tracks = Mat(10, 50, CV_64FC2, Scalar::all(1));
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
+    // Bad params.
+    FactorizationSfM::Params p;
+    p.minTrackLength = 1;
+    EXPECT_THROW(FactorizationSfM::create(p), cv::Exception);
+}
+
+TEST(Augocc_FactorizationSfM, multithread_reproducibility)
+{
+    SfmProblemParams prm;
+    prm.partialFraction = 0.4;
+    prm.outlierFraction = 0.05;
+    prm.points = 300;
+    const SfmProblem pb = makeSfmProblem(prm);
+    Reconstruction a, b;
+    setNumThreads(1);
+    ASSERT_TRUE(FactorizationSfM::create()->reconstruct(pb.tracks, a));
+    setNumThreads(4);
+    ASSERT_TRUE(FactorizationSfM::create()->reconstruct(pb.tracks, b));
+    ASSERT_EQ(a.cameras.size(), b.cameras.size());
+    for (size_t i = 0; i < a.cameras.size(); i++)
+    {
+        EXPECT_MAT_NEAR(a.cameras[i].R, b.cameras[i].R, 0);
+        EXPECT_MAT_NEAR(a.cameras[i].t, b.cameras[i].t, 0);
+    }
+    EXPECT_TRUE(identicalWithNan(a.points, b.points));
+}
+
+} // namespace
+} // namespace opencv_test
