@@ -23,10 +23,16 @@
 namespace opencv_test {
 namespace {
 using namespace cv;
+using namespace cv::augocc;
 namespace fs = std::filesystem;
 
-// Same target as the headless test (issue 6: IoU >= 0.98 with <= 12 clicks).
-const double kMinE2eIoU = 0.98;
+// The window must give exactly what the library gives for the same clicks (the e2e test checks
+// the plumbing: click mapping, closing, saving); against the truth, this near-frontal view has
+// the thin-sliver facade of accuracy_scripted_clicks_synthesized, which reaches ~0.97.
+const double kMinE2eIoU = 0.965;
+// Frame 1 proposed from the clone (key g; a clone of only two key frames 4 degrees apart, so
+// coarse in depth), snapped to this frame's edges.
+const double kMinProposedIoU = 0.95;
 // Generous limits: the window appears in ~1 s on an idle machine; 2 cores shared with builds.
 const double kStartTimeoutS = 40.0;
 const double kExitTimeoutS = 30.0;
@@ -184,17 +190,25 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     if (!shots.empty() && !haveTool("ffmpeg"))
         GTEST_SKIP() << "AUGOCC_ANNOTATE_SHOTS set but ffmpeg missing";
 
-    // Three frames of a box building seen from a slowly turning camera.
+    // Three frames of the synthesized scene from a slowly turning camera (2 degrees a frame).
     const std::string dir = tempDir("annotate");
     fs::create_directories(dir + "/frames");
-    const Size size(640, 480);
-    std::vector<SilhouetteScene> scenes;
+    SceneSynthesizer::Params sp;
+    sp.frames = 3;
+    sp.numKeyFrames = 2;
+    sp.orbitDegrees = 4;
+    sp.numTracks = 50;
+    SyntheticScene scene;
+    SceneSynthesizer::create(sp)->synthesize(scene);
+    const Size size = scene.frames[0].size();
     for (int f = 0; f < 3; ++f)
-    {
-        scenes.push_back(drawBoxScene(orbitCamera(30 + 2 * f, 25, size.height / 14.0, size),
-                                      size, 21));
-        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scenes.back().image));
-    }
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scene.frames[f]));
+    // Clones from the two default key frames (0 and 2): the g key on frame 1 proposes from them.
+    writeReconstruction(dir + "/rec.yml", scene.groundTruth);
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks);
+    clones->save(dir + "/clones.yml.gz");
+    const Mat truth0 = scene.visibleMasks.at("building").at(0);
+    const Mat truth1 = scene.visibleMasks.at("building").at(1);
     const std::string masks = dir + "/masks";
 
     const int dispNum = freeDisplay();
@@ -212,7 +226,8 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     Child tool;
     const std::string log = dir + "/annotate.log";
     tool.pid = spawn({bin, "annotate", "--input", dir + "/frames", "--masks", masks, "--object",
-                      "building", "--screenshot-dir", dir},
+                      "building", "--screenshot-dir", dir, "--reconstruction", dir + "/rec.yml",
+                      "--clones", dir + "/clones.yml.gz"},
                      {"DISPLAY=" + display, "QT_QPA_PLATFORM=xcb"}, log);
     ASSERT_GT(tool.pid, 0);
     Rect rect;
@@ -245,7 +260,7 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
 
     // Trace: the building's corners, a couple of pixels off as a hand would be.
     std::vector<std::vector<Point>> contours;
-    findContours(scenes[0].mask.clone(), contours, RETR_EXTERNAL, CHAIN_APPROX_NONE);
+    findContours(truth0.clone(), contours, RETR_EXTERNAL, CHAIN_APPROX_NONE);
     ASSERT_FALSE(contours.empty());
     std::vector<Point> corners;
     approxPolyDP(contours[0], corners, 2.0, true);
@@ -281,6 +296,10 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     }
     xdo.key("w");       // the tool's own screenshot of its canvas
     xdo.key("n");       // next frame: the traced frame is committed
+    xdo.key("g");       // propose frame 1's outline from the clone, snapped to edges
+    sleepMs(500);
+    if (!shots.empty())
+        grab(display, rect, shots + "/annotate_proposed.png");
     xdo.key("q");       // save and quit
     const int rc = tool.wait(kExitTimeoutS);
     const std::string text = readFile(log);
@@ -290,14 +309,113 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     const Mat written = imread(masks + "/building/0000.png", IMREAD_GRAYSCALE);
     ASSERT_FALSE(written.empty()) << "no mask written:\n" << text;
     EXPECT_EQ(size, written.size());
-    const double iou = maskIoU(written, scenes[0].mask);
-    std::cout << format("[ annotate e2e ] %d clicks, IoU %.4f", clickCount, iou) << std::endl;
+    const double iou = maskIoU(written, truth0);
+    const Mat proposed = imread(masks + "/building/0001.png", IMREAD_GRAYSCALE);
+    ASSERT_FALSE(proposed.empty()) << "the proposal of frame 1 was not saved:\n" << text;
+    const double iouProposed = maskIoU(proposed, truth1);
+    std::cout << format("[ annotate e2e ] %d clicks, IoU %.4f; frame 1 proposed from the clone "
+                        "(g), IoU %.4f",
+                        clickCount, iou, iouProposed)
+              << std::endl;
     EXPECT_GE(iou, kMinE2eIoU);
-    EXPECT_FALSE(fs::exists(masks + "/building/0001.png")) << "frame 1 was not traced";
+    EXPECT_GE(iouProposed, kMinProposedIoU);
+    // The same clicks and the same proposal through the library, headless: identical masks.
+    Ptr<SilhouetteEditor> ed = SilhouetteEditor::create();
+    ed->setImage(scene.frames[0]);
+    for (const Point& c : clicks)
+        ed->addPoint(c);
+    ASSERT_TRUE(ed->closeContour());
+    Mat headless0, headless1;
+    ed->getMask(headless0);
+    EXPECT_EQ(0, norm(written, headless0, NORM_INF)) << "window and library disagree";
+    std::map<String, Mat> visible;
+    proposeSilhouettes(*clones, 1, scene.groundTruth.camera(1), scene.frames[1], visible, false);
+    ed->setImage(scene.frames[1]);
+    ed->loadMask(visible.at("building"), true);
+    ed->getMask(headless1);
+    EXPECT_EQ(0, norm(proposed, headless1, NORM_INF)) << "window and library disagree (g)";
+    EXPECT_FALSE(fs::exists(masks + "/building/0002.png")) << "frame 2 was not traced";
     bool shot = false;
     for (const auto& e : fs::directory_iterator(dir))
         shot = shot || e.path().filename().string().rfind("annotate_building_0000", 0) == 0;
     EXPECT_TRUE(shot) << "the w key saved no screenshot:\n" << text;
+    fs::remove_all(dir);
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+
+// Bad input is reported before any window opens (exit 2, the flag named), display or not.
+TEST(Augocc_AnnotateE2e, bad_input)
+{
+    const std::string dir = tempDir("annotate_bad");
+    fs::create_directories(dir + "/frames");
+    ASSERT_TRUE(imwrite(dir + "/frames/0000.png", Mat(60, 80, CV_8UC3, Scalar::all(100))));
+    const std::string bin = augoccBinary() + " annotate";
+    std::string out;
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/none --masks " + dir + "/m", &out));
+    EXPECT_NE(std::string::npos, out.find("--input")) << out;
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                            "/m --suggest 3", &out));
+    EXPECT_NE(std::string::npos, out.find("--suggest")) << out;
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                            "/m --object a/b", &out));
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                            "/m --frame 3", &out));
+    EXPECT_NE(std::string::npos, out.find("--frame")) << out;
+    std::ofstream(dir + "/c.yml.gz") << "not a clone file";
+    EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                            "/m --clones " + dir + "/c.yml.gz", &out));
+    EXPECT_NE(std::string::npos, out.find("--reconstruction")) << out;
+    EXPECT_EQ(2, runCommand("env -u DISPLAY -u WAYLAND_DISPLAY " + bin + " --input " + dir +
+                            "/frames --masks " + dir + "/m", &out));
+    EXPECT_NE(std::string::npos, out.find("DISPLAY")) << out;
+    EXPECT_FALSE(fs::exists(dir + "/m"));
+    fs::remove_all(dir);
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+
+// --suggest marks (and prints) key frames before the window opens; without a display the tool
+// then stops with exit 2, which lets this test run anywhere.
+TEST(Augocc_AnnotateE2e, suggest_prints_key_frames)
+{
+    SceneSynthesizer::Params sp;
+    sp.frames = 6;
+    sp.numKeyFrames = 2;
+    sp.numTracks = 100;
+    SyntheticScene scene;
+    SceneSynthesizer::create(sp)->synthesize(scene);
+    const std::string dir = tempDir("annotate_suggest");
+    fs::create_directories(dir + "/frames");
+    for (int f = 0; f < sp.frames; ++f)
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scene.frames[f]));
+    writeTracks(dir + "/tracks.yml", scene.tracks);
+    writeReconstruction(dir + "/rec.yml", scene.groundTruth);
+    std::string out;
+    EXPECT_EQ(2, runCommand("env -u DISPLAY -u WAYLAND_DISPLAY " + augoccBinary() +
+                                " annotate --input " + dir + "/frames --masks " + dir + "/m" +
+                                " --tracks " + dir + "/tracks.yml --reconstruction " + dir +
+                                "/rec.yml --suggest 3 --object building",
+                            &out));
+    const size_t at = out.find("suggested key frames for building:");
+    ASSERT_NE(std::string::npos, at) << out;
+    std::istringstream is(out.substr(at + std::string("suggested key frames for building:").size()));
+    std::vector<int> keys(3);
+    is >> keys[0] >> keys[1] >> keys[2];
+    EXPECT_EQ(suggestKeyFrames(scene.tracks, scene.groundTruth, 3), keys) << out;
+    EXPECT_EQ(0, keys.front());
+    EXPECT_EQ(sp.frames - 1, keys.back());
     fs::remove_all(dir);
 }
 

@@ -214,3 +214,75 @@ TEST(Augocc_KeyFrames, multithread_reproducibility)
 
 } // namespace
 } // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+
+// On a synthesized sequence: the building's tracks are found from its two default key-frame
+// silhouettes, and the suggested key frames spread the appearance change better than uniform
+// spacing does (their largest step is no larger: the partition is optimal).
+TEST(Augocc_KeyFrames, accuracy_synthesized_scene)
+{
+    SceneSynthesizer::Params p;
+    p.frames = 30;
+    p.numKeyFrames = 2;  // first and last: the default key frames of the paper
+    p.numTracks = 400;
+    p.partialFraction = 0.3;
+    SyntheticScene s;
+    SceneSynthesizer::create(p)->synthesize(s);
+    const FrameMasks& masks = s.keyFrameMasks.at("building");
+    const std::vector<uchar> own = objectTracksFromMasks(s.tracks, masks, &s.groundTruth);
+    // The flagged tracks' true points lie on the building (its box, grown by 2% for noise).
+    const int b = int(std::find(s.objectNames.begin(), s.objectNames.end(), "building") -
+                      s.objectNames.begin());
+    Vec3f lo, hi;
+    s.objectMeshes[b].bounds(lo, hi);
+    const Vec3f pad = 0.02f * (hi - lo);
+    int flagged = 0, onBuilding = 0;
+    for (int i = 0; i < s.tracks.points(); ++i)
+    {
+        if (!own[i])
+            continue;
+        ++flagged;
+        const Vec3d X = s.groundTruth.points.at<Vec3d>(i);
+        bool in = true;
+        for (int k = 0; k < 3; ++k)
+            in = in && X[k] >= lo[k] - pad[k] && X[k] <= hi[k] + pad[k];
+        onBuilding += in ? 1 : 0;
+    }
+    const double kMinPrecision = 0.9;  // visual-hull membership from two views admits a few
+    ASSERT_GT(flagged, 10);
+    EXPECT_GE(double(onBuilding) / flagged, kMinPrecision) << onBuilding << "/" << flagged;
+
+    const int count = 5;
+    const double degreesPerChange = 30.0;  // the default of suggestKeyFrames
+    const std::vector<int> keys = suggestKeyFrames(s.tracks, s.groundTruth, count, masks);
+    ASSERT_EQ(size_t(count), keys.size());
+    EXPECT_EQ(0, keys.front());
+    EXPECT_EQ(p.frames - 1, keys.back());
+    const Mat view = viewChangeMatrix(s.groundTruth), vis = visibilityChangeMatrix(s.tracks, own);
+    auto change = [&](int a, int c) {
+        return std::max(view.at<double>(a, c) / degreesPerChange, vis.at<double>(a, c));
+    };
+    auto bottleneck = [&](const std::vector<int>& k) {
+        double m = 0;
+        for (size_t i = 1; i < k.size(); ++i)
+            m = std::max(m, change(k[i - 1], k[i]));
+        return m;
+    };
+    std::vector<int> uniform;
+    for (int i = 0; i < count; ++i)
+        uniform.push_back(cvRound(double(i) * (p.frames - 1) / (count - 1)));
+    std::string list;
+    for (int k : keys)
+        list += format(" %d", k);
+    std::cout << format("[ key frames ]%s: largest step %.3f (uniform spacing: %.3f)",
+                        list.c_str(), bottleneck(keys), bottleneck(uniform))
+              << std::endl;
+    EXPECT_LE(bottleneck(keys), bottleneck(uniform) + 1e-12);
+}
+
+} // namespace
+} // namespace opencv_test

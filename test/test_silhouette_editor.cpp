@@ -291,6 +291,28 @@ TEST(Augocc_SilhouetteEditor, accuracy_snap_proposed_mask)
     EXPECT_TRUE(ed->canUndo());
 }
 
+TEST(Augocc_SilhouetteEditor, multithread_reproducibility)
+{
+    SilhouetteScene scene = makeBoxScene(Size(640, 480), 9);
+    Mat proposal;
+    dilate(scene.mask, proposal, getStructuringElement(MORPH_ELLIPSE, Size(7, 7)));
+    Mat snapped[2], traced[2];
+    const int threads[2] = {1, 4};
+    for (int i = 0; i < 2; ++i)
+    {
+        setNumThreads(threads[i]);
+        Ptr<SilhouetteEditor> ed = SilhouetteEditor::create();
+        ed->setImage(scene.image);
+        ed->snapMask(proposal, snapped[i]);
+        for (const Point& c : outlineCorners(scene.mask))
+            ed->addPoint(c);
+        ASSERT_TRUE(ed->closeContour());
+        ed->getMask(traced[i]);
+    }
+    EXPECT_EQ(0, norm(snapped[0], snapped[1], NORM_INF));
+    EXPECT_EQ(0, norm(traced[0], traced[1], NORM_INF));
+}
+
 TEST(Augocc_SilhouetteEditor, overlay_draws)
 {
     SilhouetteScene scene = makeBoxScene(Size(320, 240), 8);
@@ -475,7 +497,7 @@ TEST(Augocc_SilhouetteEditor, accuracy_proposals_synthesized_gt_derived)
 {
     const SyntheticScene& s = synthScene();
     const double kMinMeanIoU = 0.97;   // issue 6: proposed silhouettes, before any correction
-    const double kMinWorstIoU = 0.94;  // no single frame far off (regression guard)
+    const double kMinWorstIoU = 0.95;  // no single frame far off (regression guard)
     const Mat grow = getStructuringElement(MORPH_ELLIPSE, Size(5, 5));
     const Matx23d shift(1, 0, 2, 0, 1, -1);
     std::set<int> keys(s.keyFrames.begin(), s.keyFrames.end());
@@ -513,6 +535,110 @@ TEST(Augocc_SilhouetteEditor, accuracy_proposals_synthesized_gt_derived)
         EXPECT_GT(sumAfter, sumBefore);
         EXPECT_GE(worst, kMinWorstIoU);
     }
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+
+// Done-when 3 with real clones: SceneSynthesizer sequence, clones built by CloneBuilder from the
+// key-frame silhouettes and the true cameras, proposed silhouettes (clone matte, depth-resolved,
+// snapped) in every non-key frame against the true visible silhouettes, before any correction.
+TEST(Augocc_SilhouetteEditor, accuracy_proposals_from_clones)
+{
+    SceneSynthesizer::Params sp;
+    sp.frames = 24;
+    sp.numKeyFrames = 4;
+    sp.numTracks = 300;
+    SyntheticScene s;
+    SceneSynthesizer::create(sp)->synthesize(s);
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(s.groundTruth, s.keyFrameMasks);
+    const double kMinMeanIoU = 0.97;   // issue 6: proposed silhouettes, non-key frames
+    const double kMinWorstIoU = 0.95;  // per object-frame, regression guard
+    std::set<int> keys(s.keyFrames.begin(), s.keyFrames.end());
+    double sumRaw = 0, sumSnapped = 0, worst = 1;
+    int n = 0;
+    for (int f = 0; f < sp.frames; ++f)
+    {
+        if (keys.count(f))
+            continue;
+        const Camera& cam = s.groundTruth.camera(f);
+        std::map<String, Mat> raw, snapped;
+        proposeSilhouettes(*clones, f, cam, s.frames[f], raw, false);
+        proposeSilhouettes(*clones, f, cam, s.frames[f], snapped, true);
+        for (const String& name : s.objectNames)
+        {
+            const Mat& truth = s.visibleMasks.at(name).at(f);
+            const double iou = maskIoU(snapped.at(name), truth);
+            sumRaw += maskIoU(raw.at(name), truth);
+            sumSnapped += iou;
+            worst = std::min(worst, iou);
+            ++n;
+        }
+    }
+    std::cout << format("[ proposals from clones ] %d object-frames: mean IoU %.4f projected, "
+                        "%.4f snapped, worst snapped %.4f", n, sumRaw / n, sumSnapped / n, worst)
+              << std::endl;
+    EXPECT_GE(sumSnapped / n, kMinMeanIoU);
+    EXPECT_GE(worst, kMinWorstIoU);
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+
+// `augocc propagate --clones`: the headless path of item 3, from files as the CLI sees them.
+TEST(Augocc_PropagateCli, clones_to_proposed_masks)
+{
+    SceneSynthesizer::Params sp;
+    sp.frames = 8;
+    sp.numKeyFrames = 3;
+    sp.numTracks = 200;
+    SyntheticScene s;
+    SceneSynthesizer::create(sp)->synthesize(s);
+    const std::string dir = tempDir("propagate_clones");
+    std::filesystem::create_directories(dir + "/frames");
+    for (int f = 0; f < sp.frames; ++f)
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), s.frames[f]));
+    writeReconstruction(dir + "/rec.yml", s.groundTruth);
+    CloneBuilder::create()->build(s.groundTruth, s.keyFrameMasks)->save(dir + "/clones.yml.gz");
+    const std::string base = augoccBinary() + " propagate --input " + dir + "/frames" +
+                             " --reconstruction " + dir + "/rec.yml --clones " + dir +
+                             "/clones.yml.gz";
+    std::string out;
+    ASSERT_EQ(0, runCommand(base + " --frames 1,2:3 --out " + dir + "/proposed", &out)) << out;
+    const double kMinMeanIoU = 0.97;  // issue 6 target for proposals
+    double sum = 0;
+    int n = 0;
+    for (const String& name : s.objectNames)
+        for (int f : {1, 2, 3})
+        {
+            const Mat m = imread(format("%s/proposed/%s/%04d.png", dir.c_str(), name.c_str(), f),
+                                 IMREAD_GRAYSCALE);
+            ASSERT_FALSE(m.empty()) << name << " frame " << f << "\n" << out;
+            sum += maskIoU(m, s.visibleMasks.at(name).at(f));
+            ++n;
+        }
+    EXPECT_GE(sum / n, kMinMeanIoU);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/proposed/building/0000.png"));
+    // One object only; an unknown object and a frame without a camera are usage errors.
+    ASSERT_EQ(0, runCommand(base + " --frames 4 --object tower --out " + dir + "/one", &out))
+        << out;
+    EXPECT_TRUE(std::filesystem::exists(dir + "/one/tower/0004.png"));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/one/building"));
+    EXPECT_EQ(2, runCommand(base + " --frames 4 --object nosuch --out " + dir + "/bad", &out));
+    EXPECT_NE(std::string::npos, out.find("nosuch")) << out;
+    EXPECT_EQ(2, runCommand(base + " --frames 9 --out " + dir + "/bad", &out));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/bad"));
+    std::filesystem::remove_all(dir);
 }
 
 } // namespace

@@ -4,6 +4,8 @@
 
 #include "cli_common.hpp"
 
+#include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -37,7 +39,7 @@ const char* const kHelp[][2] = {
     {"u, z  /  r, y", "undo  /  redo"},
     {"i  /  d", "insert anchor on segment  /  delete anchor (at cursor)"},
     {"x", "clear this frame's silhouette"},
-    {"g", "propose outline from the nearest key frame, snapped"},
+    {"g", "propose outline: from the clone (--clones) or nearest key frame"},
     {"n, .  /  p, ,", "next  /  previous frame"},
     {"]  /  [", "next  /  previous key frame"},
     {"k", "mark / unmark this frame as a key frame"},
@@ -48,7 +50,7 @@ const char* const kHelp[][2] = {
 
 struct Options
 {
-    std::string input, masks, tracks, reconstruction, screenshotDir;
+    std::string input, masks, tracks, reconstruction, clones, screenshotDir;
     std::vector<std::string> objects;
     int frame = 0, suggest = 0;
 };
@@ -75,9 +77,28 @@ public:
             addObject("object");
         if (!opt_.objects.empty())
             object_ = indexOf(opt_.objects.front());
+        if (!opt_.clones.empty())
+        {
+            if (opt_.reconstruction.empty())
+                throw UsageError("--clones needs --reconstruction");
+            rec_ = readReconstruction(opt_.reconstruction);
+            if (rec_.imageSize != frameSize_)
+                throw UsageError(format("--reconstruction %s: image size %dx%d, the frames are "
+                                        "%dx%d", opt_.reconstruction.c_str(),
+                                        rec_.imageSize.width, rec_.imageSize.height,
+                                        frameSize_.width, frameSize_.height));
+            clones_ = CloneSet::load(opt_.clones);
+        }
         suggestKeyFrameMarks();
-        frame_ = std::min(std::max(opt_.frame, 0), frameCount_ - 1);
+        if (opt_.frame < 0 || opt_.frame >= frameCount_)
+            throw UsageError(format("--frame %d: the input has frames 0..%d", opt_.frame,
+                                    frameCount_ - 1));
+        frame_ = opt_.frame;
         loadFrame();
+        // Qt aborts the process when it cannot reach a display: say so first.
+        if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY"))
+            throw UsageError("annotate opens a window and needs a display: set DISPLAY (or run "
+                             "it under xvfb-run)");
 
         namedWindow(kWindow, WINDOW_AUTOSIZE | WINDOW_GUI_NORMAL);
         setMouseCallback(kWindow, &AnnotateApp::onMouse, this);
@@ -450,6 +471,25 @@ private:
     void propose()
     {
         commitEditor();
+        if (clones_ && rec_.findCamera(frame_) >= 0)
+        {
+            const std::vector<String> names = clones_->objectNames();
+            if (std::find(names.begin(), names.end(), objectName()) != names.end())
+            {
+                // The clone's visible part (depth-resolved against the other clones), loaded
+                // with snapping: the same outline as proposeSilhouettes(), as editable anchors.
+                std::map<String, Mat> visible;
+                proposeSilhouettes(*clones_, frame_, rec_.camera(frame_), image_, visible, false);
+                if (countNonZero(visible[objectName()]) == 0)
+                {
+                    status_ = "the clone of " + objectName() + " is hidden in this frame";
+                    return;
+                }
+                editor_->loadMask(visible[objectName()], true);
+                status_ = "proposed from the clone, snapped to edges";
+                return;
+            }
+        }
         const FrameMasks& fm = masks_[objectName()];
         int best = -1;
         for (const auto& m : fm)
@@ -577,6 +617,8 @@ private:
     Options opt_;
     const Globals& g_;
     Ptr<FrameSource> source_;
+    Reconstruction rec_;     // with --clones: cameras for the clone proposals
+    Ptr<CloneSet> clones_;
     int frameCount_ = 0;
     Size frameSize_;
     ObjectMasks masks_;
@@ -611,6 +653,9 @@ void registerAnnotate(CLI::App& app, Globals& g)
     sub->add_option("--tracks", opt->tracks, "tracks.yml for key-frame suggestions");
     sub->add_option("--reconstruction", opt->reconstruction,
                     "reconstruction.yml for key-frame suggestions");
+    sub->add_option("--clones", opt->clones,
+                    "clones file: the g key proposes outlines from the clones (needs "
+                    "--reconstruction)");
     sub->add_option("--suggest", opt->suggest,
                     "mark this many suggested key frames (needs --tracks and/or "
                     "--reconstruction)");
@@ -622,6 +667,8 @@ void registerAnnotate(CLI::App& app, Globals& g)
             requireFile("--tracks", opt->tracks);
         if (!opt->reconstruction.empty())
             requireFile("--reconstruction", opt->reconstruction);
+        if (!opt->clones.empty())
+            requireFile("--clones", opt->clones);
         if (opt->suggest < 0)
             throw UsageError("--suggest must be >= 0");
         AnnotateApp app(*opt, g);

@@ -12,7 +12,8 @@ SilhouetteEditor::Params::Params()
     : weightNonEdge(0.43f), weightGradientDirection(0.43f), weightGradientMagnitude(0.14f),
       gradientMagnitudeMax(150.f), cannyLow(32), cannyHigh(100), clickSnapRadius(2),
       searchMargin(24), outerEdgeBias(0.5f), outerEdgeBand(4), outlineTolerance(1.0),
-      snapSpacing(10), snapRadius(6), minContourArea(20), refineBoundary(true)
+      snapSpacing(10), snapRadius(4), snapDistancePenalty(0.3f), minContourArea(20),
+      refineBoundary(true)
 {
 }
 
@@ -124,6 +125,9 @@ public:
                      format("SilhouetteEditor: clickSnapRadius (%d), searchMargin (%d), "
                             "snapRadius (%d) must be >= 0 and snapSpacing (%d) >= 2",
                             p.clickSnapRadius, p.searchMargin, p.snapRadius, p.snapSpacing));
+        if (!(p.snapDistancePenalty >= 0 && p.snapDistancePenalty <= 1))
+            CV_Error(Error::StsBadArg, format("SilhouetteEditor: snapDistancePenalty (%g) must be "
+                                              "in [0, 1]", p.snapDistancePenalty));
         if (!(p.outerEdgeBias >= 0) || p.outerEdgeBand < 0)
             CV_Error(Error::StsBadArg,
                      format("SilhouetteEditor: outerEdgeBias (%g) and outerEdgeBand (%d) must be "
@@ -826,9 +830,9 @@ private:
                 base[k] = c[i];
                 normal[k] = Point2f(t.y, -t.x);
                 float best = -1.f, bestT = 0.f;
-                // Half-pixel steps; a mild preference for small moves breaks ties toward the
-                // proposal (kDistancePenalty: 10% of the score at the full radius).
-                const float kDistancePenalty = 0.1f;
+                // Half-pixel steps; a preference for small moves (Params::snapDistancePenalty
+                // of the score at the full radius) keeps the sample near the proposal.
+                const float kDistancePenalty = params_.snapDistancePenalty;
                 for (int j = -2 * R; j <= 2 * R; ++j)
                 {
                     const float tt = 0.5f * j;

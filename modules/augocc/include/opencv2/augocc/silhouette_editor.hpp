@@ -72,8 +72,11 @@ public:
         double outlineTolerance;
         //! snapMask(): spacing of the outline samples that are snapped (pixels, default 10).
         int snapSpacing;
-        //! snapMask(): how far along the outline normal a sample may move (pixels, default 6).
+        //! snapMask(): how far along the outline normal a sample may move (pixels, default 4).
         int snapRadius;
+        //! snapMask(): preference for small moves: an edge at the full snapRadius scores this
+        //! fraction less than the same edge on the proposed outline (default 0.3).
+        float snapDistancePenalty;
         //! Contours whose area is below this are ignored when a mask is loaded (pixels,
         //! default 20).
         double minContourArea;
