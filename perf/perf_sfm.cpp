@@ -116,6 +116,8 @@ void Augocc_FeatureTracker_track(benchmark::State& state)
     }
     cv::augocc::FeatureTracker::Params p;
     p.maxTracks = 1000;
+    p.winSize = cv::Size((int)state.range(2), (int)state.range(2));
+    p.levels = (int)state.range(3);
     cv::Ptr<cv::augocc::FeatureTracker> tracker = cv::augocc::FeatureTracker::create(p);
     cv::augocc::Tracks tracks;
     for (auto _ : state)
@@ -130,6 +132,7 @@ void Augocc_FeatureTracker_track(benchmark::State& state)
 }
 
 BENCHMARK(Augocc_FeatureTracker_track)->Name("Augocc_FeatureTracker/track_30_frames")
-    ->ArgNames({"w", "h"})->Args({640, 480})->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->ArgNames({"w", "h", "win", "levels"})->Args({640, 480, 11, 3})->Args({640, 480, 15, 3})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace

@@ -47,10 +47,11 @@ Modes (Params::mode):
   under a robust loss. Gauge: the first camera's rotation and the first camera's zoom are held.
 - PERSPECTIVE_BA: the perspective upgrade of an affine solution, a bundle adjustment of the
   pinhole model written in the "perspective strength" form u = s * Xc.x / (1 + kappa * Xc.z) + cx
-  (Xc relative to a reference depth 1/kappa; f = s / kappa), which is well conditioned near
-  orthography. It starts at kappa = 0, i.e. exactly at the scaled-orthographic solution, and
-  refines rotations, translations, points and kappa (one focal length, fx = fy, principal point
-  at the image centre) under a robust loss. A negative kappa is the depth-reversed twin and is
+  (Xc relative to a reference depth 1/kappa; f = s / kappa, after Szeliski & Kang
+  @cite Szeliski1994), which is well conditioned near orthography. It starts at kappa = 0,
+  i.e. exactly at the scaled-orthographic solution, and refines rotations, translations, points
+  and kappa (one focal length, fx = fy, principal point at the image centre) under a robust
+  loss. A negative kappa is the depth-reversed twin and is
   flipped, which resolves the orthographic depth-reversal ambiguity. The output model is
   PERSPECTIVE; with no measurable perspective the camera ends 1e4 scene radii away.
 

@@ -15,8 +15,8 @@ namespace augocc {
 //! @{
 
 /** @brief Feature tracks for the factorization: Shi-Tomasi corners @cite Shi1994 followed by
-pyramidal Lucas-Kanade (OpenCV video module) with a forward-backward check, and re-detection that
-keeps about `maxTracks` live tracks spread over the image.
+pyramidal Lucas-Kanade (OpenCV video module) with a forward-backward check @cite Kalal2010,
+and re-detection that keeps about `maxTracks` live tracks spread over the image.
 
 A track starts where a corner is detected and ends when Lucas-Kanade loses it, when tracking
 back from the new frame does not return within `fbThreshold` pixels of where it started, when
@@ -36,7 +36,7 @@ public:
         double quality;         //!< Shi-Tomasi quality level, relative to the best (0.01)
         double minDistance;     //!< minimum distance between tracks, pixels (default 8)
         int blockSize;          //!< Shi-Tomasi gradient window (default 3)
-        Size winSize;           //!< Lucas-Kanade window (default 15 x 15)
+        Size winSize;           //!< Lucas-Kanade window (default 11 x 11)
         int levels;             //!< pyramid levels above the base (default 3)
         double fbThreshold;     //!< forward-backward error above which a track ends, px (1.0)
         double redetectRatio;   //!< re-detect when live tracks < this * maxTracks (0.9)
