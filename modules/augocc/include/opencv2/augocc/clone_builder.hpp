@@ -60,7 +60,8 @@ public:
 
     //! Key frames of an object (frames holding a patch set), increasing.
     virtual std::vector<int> keyFrames(const String& object) const = 0;
-    //! The key frame whose patch voxels apply to `frame` (per the builder's patch-frame rule).
+    //! The key frames whose patch voxels apply to `frame`: the frame itself when it is a key
+    //! frame, else per the builder's PatchRule (one, or the two around it).
     virtual std::vector<int> patchFrames(const String& object, int frame) const = 0;
     //! Number of voxels of the trimmed model (without patches).
     virtual int voxelCount(const String& object) const = 0;
