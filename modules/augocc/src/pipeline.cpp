@@ -351,5 +351,320 @@ CompositeScore scoreComposite(InputArray compositeArr, InputArray truthArr, Inpu
     return s;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Alignment with a reference reconstruction
+
+Matx44d alignReconstructions(const Reconstruction& rec, const Reconstruction& ref)
+{
+    std::vector<std::pair<const Camera*, const Camera*> > pairs;
+    for (const Camera& c : rec.cameras)
+    {
+        const int j = ref.findCamera(c.frame);
+        if (j >= 0)
+            pairs.push_back({&c, &ref.cameras[j]});
+    }
+    if (pairs.size() < 3)
+        CV_Error(Error::StsBadArg, "alignReconstructions: fewer than three common frames");
+    // X_rec = sigma * Q * X_ref + T  (Q: R_rec Q = R_ref for every frame).
+    Matx33d S = Matx33d::zeros();
+    for (const auto& p : pairs)
+        S += p.first->R.t() * p.second->R;
+    Mat w, u, vt;
+    cv::SVDecomp(Mat(S), w, u, vt);
+    Mat Qm = u * vt;
+    if (cv::determinant(Qm) < 0)
+    {
+        Mat D = Mat::eye(3, 3, CV_64F);
+        D.at<double>(2, 2) = -1;
+        Qm = u * D * vt;
+    }
+    const Matx33d Q((double*)Qm.ptr<double>());
+    double sigma = 0;
+    Vec3d T;
+    if (rec.model == SCALED_ORTHOGRAPHIC)
+    {
+        // s_rec * sigma = s_ref; (R_rec T)_xy = (s_ref / s_rec) t_ref_xy / sigma ... in rec units:
+        // s_rec (R_rec T + t_rec)_xy = s_ref t_ref_xy.
+        for (const auto& p : pairs)
+            sigma += p.second->s / p.first->s;
+        sigma /= pairs.size();
+        Mat A((int)pairs.size() * 2, 3, CV_64F), b((int)pairs.size() * 2, 1, CV_64F);
+        for (size_t i = 0; i < pairs.size(); i++)
+        {
+            const Camera& c = *pairs[i].first;
+            const Camera& r = *pairs[i].second;
+            for (int k = 0; k < 2; k++)
+            {
+                for (int j = 0; j < 3; j++)
+                    A.at<double>(2 * (int)i + k, j) = c.R(k, j);
+                b.at<double>(2 * (int)i + k) = r.s / c.s * r.t[k] - c.t[k];
+            }
+        }
+        Mat x;
+        cv::solve(A, b, x, DECOMP_SVD);
+        T = Vec3d(x.at<double>(0), x.at<double>(1), x.at<double>(2));
+    }
+    else
+    {
+        // R_rec T - sigma t_ref = -t_rec, 3 equations per frame, unknowns (T, sigma).
+        Mat A((int)pairs.size() * 3, 4, CV_64F), b((int)pairs.size() * 3, 1, CV_64F);
+        for (size_t i = 0; i < pairs.size(); i++)
+        {
+            const Camera& c = *pairs[i].first;
+            const Camera& r = *pairs[i].second;
+            for (int k = 0; k < 3; k++)
+            {
+                for (int j = 0; j < 3; j++)
+                    A.at<double>(3 * (int)i + k, j) = c.R(k, j);
+                A.at<double>(3 * (int)i + k, 3) = -r.t[k];
+                b.at<double>(3 * (int)i + k) = -c.t[k];
+            }
+        }
+        Mat x;
+        cv::solve(A, b, x, DECOMP_SVD);
+        T = Vec3d(x.at<double>(0), x.at<double>(1), x.at<double>(2));
+        sigma = x.at<double>(3);
+    }
+    if (!(sigma > 0))
+        CV_Error(Error::StsBadArg, "alignReconstructions: degenerate scale");
+    // Invert: X_ref = Q^T (X_rec - T) / sigma.
+    const Matx33d A = Q.t() * (1.0 / sigma);
+    const Vec3d t = -(A * T);
+    return Matx44d(A(0, 0), A(0, 1), A(0, 2), t[0], A(1, 0), A(1, 1), A(1, 2), t[1],
+                   A(2, 0), A(2, 1), A(2, 2), t[2], 0, 0, 0, 1);
+}
+
+// ---------------------------------------------------------------------------------------------
+// augocc run
+
+namespace {
+
+class StageTimer
+{
+public:
+    explicit StageTimer(RunResult& r) : r_(r) {}
+    void start() { t0_ = cv::getTickCount(); }
+    void stop(const String& stage)
+    {
+        r_.stageSeconds.push_back({stage, (cv::getTickCount() - t0_) / cv::getTickFrequency()});
+    }
+
+private:
+    RunResult& r_;
+    int64 t0_ = 0;
+};
+
+} // namespace
+
+RunResult runPipeline(const RunOptions& o)
+{
+    if (o.outDir.empty())
+        CV_Error(Error::StsBadArg, "no output folder given");
+    auto progress = [&](const String& stage, int done, int total) {
+        if (o.progress)
+            o.progress(stage, done, total);
+    };
+    RunResult r;
+    StageTimer timer(r);
+    // Bad inputs first, before any work or output: the input, the masks, the scene.
+    Ptr<FrameSource> src = FrameSource::open(o.input);
+    const ObjectMasks masks = readMasks(o.masksDir, src->size());
+    if (masks.empty())
+        CV_Error(Error::StsBadArg, o.masksDir + ": no object folder with masks");
+    VirtualScene scene;
+    if (!o.scenePath.empty())
+        scene = readScene(o.scenePath);
+    fs::create_directories(o.outDir);
+    const fs::path dir(o.outDir);
+
+    timer.start();
+    progress("track", 0, src->count());
+    FeatureTracker::create()->track(src, r.tracks, [&](int d, int t) { progress("track", d, t); });
+    writeTracks((dir / "tracks.yml").string(), r.tracks);
+    timer.stop("track");
+
+    timer.start();
+    progress("sfm", 0, 1);
+    r.reconstruction = recoverCameras(r.tracks);
+    writeReconstruction((dir / "reconstruction.yml").string(), r.reconstruction);
+    progress("sfm", 1, 1);
+    timer.stop("sfm");
+
+    timer.start();
+    progress("clone", 0, 1);
+    r.clones = CloneBuilder::create()->build(r.reconstruction, masks, &r.tracks);
+    r.clones->save((dir / "clones.yml.gz").string());
+    progress("clone", 1, 1);
+    timer.stop("clone");
+
+    timer.start();
+    progress("matte", 0, 1);
+    writeMattes((dir / "mattes").string(), *r.clones, r.reconstruction);
+    progress("matte", 1, 1);
+    timer.stop("matte");
+
+    if (!o.scenePath.empty())
+    {
+        timer.start();
+        r.virtualObjects = placeScene(scene, r.reconstruction, r.clones.get());
+        CompositeOptions co;
+        co.supersample = o.supersample;
+        co.firstFrame = r.reconstruction.cameras.front().frame;
+        co.endFrame = r.reconstruction.cameras.back().frame + 1;
+        co.progress = [&](int d, int t) { progress("composite", d, t); };
+        r.compositePath = (dir / "composite.mp4").string();
+        progress("composite", 0, co.endFrame - co.firstFrame);
+        compositeSequence(o.input, r.reconstruction, *r.clones, r.virtualObjects,
+                          r.compositePath, co);
+        timer.stop("composite");
+    }
+    return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// augocc demo
+
+namespace {
+
+// The demo's virtual objects after the paper's Fig. 3: a dome behind the front building
+// (partly hidden by it, peeking out on its right) and a tree in front of it.
+VirtualScene demoScene(const String& path)
+{
+    VirtualScene s;
+    s.path = path;
+    SceneObject dome;
+    dome.name = "dome";
+    dome.shape = "dome";
+    dome.meshes = proceduralShape("dome");
+    dome.placement = SceneObject::PLACE_BEHIND;
+    dome.anchor = "building";
+    dome.distance = 0.1;
+    dome.size = 0.7;
+    dome.offset = Vec3d(0.45, 0, 0);
+    SceneObject tree;
+    tree.name = "tree";
+    tree.shape = "tree";
+    tree.meshes = proceduralShape("tree");
+    tree.placement = SceneObject::PLACE_IN_FRONT;
+    tree.anchor = "building";
+    tree.distance = 0.15;
+    tree.size = 0.6;
+    tree.offset = Vec3d(-0.2, 0, 0);
+    s.objects = {dome, tree};
+    return s;
+}
+
+Mat alphaOf(const Mat& bgra)
+{
+    Mat a;
+    cv::extractChannel(bgra, a, 3);
+    return a;
+}
+
+} // namespace
+
+DemoResult runDemo(const DemoOptions& o)
+{
+    DemoResult res;
+    const fs::path dir(o.outDir);
+    fs::create_directories(dir / "input");
+    SceneSynthesizer::Params sp;
+    sp.frames = o.frames;
+    sp.imageSize = o.imageSize;
+    Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
+    SyntheticScene scene;
+    if (o.progress)
+        o.progress("synth", 0, 1);
+    synth->synthesize(scene);
+    if (o.progress)
+        o.progress("synth", 1, 1);
+    // The input: frames as PNG (lossless), key-frame masks, the scene file.
+    const String framesDir = (dir / "input" / "frames").string();
+    writeAtomically(framesDir, [&](const String& tmp) {
+        fs::create_directories(tmp);
+        for (size_t f = 0; f < scene.frames.size(); f++)
+            writeImage((fs::path(tmp) / cv::format("%04d.png", (int)f)).string(),
+                       scene.frames[f]);
+    });
+    const String masksDir = (dir / "input" / "masks").string();
+    writeMasks(masksDir, scene.keyFrameMasks);
+    res.scenePath = (dir / "scene.yml").string();
+    writeScene(res.scenePath, demoScene(res.scenePath));
+
+    RunOptions ro;
+    ro.input = framesDir;
+    ro.masksDir = masksDir;
+    ro.scenePath = res.scenePath;
+    ro.outDir = o.outDir;
+    ro.progress = o.progress;
+    res.run = runPipeline(ro);
+    res.compositePath = res.run.compositePath;
+
+    // Score against the ground truth: the placed objects mapped into the true world.
+    const Reconstruction& rec = res.run.reconstruction;
+    const Matx44d M = alignReconstructions(rec, scene.groundTruth);
+    std::vector<Mesh> truthMeshes = res.run.virtualObjects;
+    for (Mesh& m : truthMeshes)
+        m.transform(M);
+    const Matx33d Ma(M(0, 0), M(0, 1), M(0, 2), M(1, 0), M(1, 1), M(1, 2), M(2, 0), M(2, 1),
+                     M(2, 2));
+    const double sigma = std::cbrt(cv::determinant(Ma));
+    Compositor::Params hard;
+    hard.supersample = 1;
+    Ptr<Compositor> ours = Compositor::create(), ref = Compositor::create(hard);
+    ours->setVirtualObjects(res.run.virtualObjects);
+    ref->setVirtualObjects(truthMeshes);
+    std::vector<Mat> before, after;
+    std::vector<String> captions;
+    const int n = (int)scene.frames.size();
+    const int kSheetFrames = 4;
+    int scored = 0;
+    for (int f = 0; f < n; f++)
+    {
+        if (rec.findCamera(f) < 0)
+            continue;
+        const Camera& cam = rec.camera(f);
+        const Camera& gtCam = scene.groundTruth.camera(f);
+        res.rotationErrorDeg += rotationAngleDeg(cam.R * (Ma.t() * sigma), gtCam.R);
+        Mat result, layer, truth, refImg, refLayer, silImg, silLayer;
+        ours->composite(scene.frames[f], f, cam, *res.run.clones, result, layer);
+        synth->renderWithVirtual(f, truthMeshes, truth, ours->getParams().supersample);
+        Mat real = scene.depth[f].clone();
+        real.setTo(std::numeric_limits<float>::infinity(), scene.labels[f] == 0);
+        ref->composite(scene.frames[f], gtCam, real, refImg, refLayer);
+        ref->composite(scene.frames[f], gtCam, noArray(), silImg, silLayer);
+        const CompositeScore s = scoreComposite(result, truth, alphaOf(layer),
+                                                alphaOf(refLayer) > 0, alphaOf(silLayer) > 0);
+        res.fractionWithin += s.fractionWithin;
+        res.boundaryDistance += s.boundaryDistance;
+        scored++;
+        if (f % std::max(1, (n - 1) / (kSheetFrames - 1)) == 0 &&
+            (int)before.size() < kSheetFrames)
+        {
+            before.push_back(scene.frames[f]);
+            after.push_back(result);
+        }
+    }
+    CV_Assert(scored > 0);
+    res.fractionWithin /= scored;
+    res.boundaryDistance /= scored;
+    res.rotationErrorDeg /= scored;
+    std::vector<Mat> sheet;
+    for (size_t i = 0; i < before.size(); i++)
+    {
+        sheet.push_back(before[i]);
+        captions.push_back(cv::format("frame %d: input", (int)(i * ((n - 1) / (kSheetFrames - 1)))));
+    }
+    for (size_t i = 0; i < after.size(); i++)
+    {
+        sheet.push_back(after[i]);
+        captions.push_back(cv::format("frame %d: composite", (int)(i * ((n - 1) / (kSheetFrames - 1)))));
+    }
+    res.contactSheetPath = (dir / "contact_sheet.png").string();
+    const Mat sheetImg = makeContactSheet(sheet, captions, (int)before.size(), 320);
+    writeAtomically(res.contactSheetPath, [&](const String& tmp) { writeImage(tmp, sheetImg); });
+    return res;
+}
+
 } // namespace augocc
 } // namespace cv

@@ -99,6 +99,66 @@ CV_EXPORTS CompositeScore scoreComposite(InputArray composite, InputArray truth,
                                          InputArray visibleTruth, InputArray silhouette,
                                          int greyTolerance = 8, int bandRadius = 2);
 
+/** @brief Similarity that maps the world of `rec` onto the world of `reference` (X_ref =
+M * X_rec), estimated from the cameras of the frames both have: rotation from the camera
+rotations, scale from the zooms (or a joint least-squares with the translation for PERSPECTIVE),
+translation by least squares on the camera translations. Used to compare a reconstruction with
+the synthetic ground truth. Throws StsBadArg without three common frames. */
+CV_EXPORTS Matx44d alignReconstructions(const Reconstruction& rec, const Reconstruction& reference);
+
+//! Options of runPipeline() (`augocc run`).
+struct CV_EXPORTS RunOptions
+{
+    String input;            //!< video, image folder or printf pattern
+    String masksDir;         //!< key-frame masks, MASKS/<object>/%04d.png
+    String scenePath;        //!< scene.yml; empty: stop after the mattes
+    String outDir;           //!< every intermediate file and the composite go here
+    int supersample = 3;     //!< compositor supersampling (1: hard edges)
+    //! Stage progress: (stage name, done, total); a stage starts with done = 0.
+    std::function<void(const String& stage, int done, int total)> progress;
+};
+
+//! What runPipeline() produced.
+struct CV_EXPORTS RunResult
+{
+    Tracks tracks;
+    Reconstruction reconstruction;
+    Ptr<CloneSet> clones;
+    std::vector<Mesh> virtualObjects;   //!< placed, world frame of the reconstruction
+    String compositePath;               //!< empty without a scene
+    std::vector<std::pair<String, double> > stageSeconds;  //!< wall time per stage
+};
+
+/** @brief track -> sfm -> clone -> matte -> composite, writing into outDir: tracks.yml,
+reconstruction.yml, clones.yml.gz, mattes/, composite.mp4 (contract). Throws as the stages do. */
+CV_EXPORTS RunResult runPipeline(const RunOptions& options);
+
+//! Options of runDemo() (`augocc demo`).
+struct CV_EXPORTS DemoOptions
+{
+    String outDir = "augocc_demo";
+    int frames = 60;
+    Size imageSize = Size(640, 480);
+    std::function<void(const String& stage, int done, int total)> progress;
+};
+
+//! What runDemo() produced and measured.
+struct CV_EXPORTS DemoResult
+{
+    String compositePath, contactSheetPath, scenePath;
+    RunResult run;
+    double fractionWithin = 0;   //!< mean over frames, composite vs ground truth (8 grey levels)
+    double boundaryDistance = 0; //!< mean over frames, occlusion boundary, px
+    double rotationErrorDeg = 0; //!< mean camera rotation error after alignment
+};
+
+/** @brief The embedded demo: synthesizes a scene, writes its video and key-frame masks, a
+scene.yml with a procedural dome behind the front building and a tree in front of it, runs
+runPipeline() on the synthesized frames from tracking on, writes a contact sheet of frames
+before and after, and scores the composite against the synthesizer's ground truth (the
+reconstruction aligned to the true world by alignReconstructions()). */
+CV_EXPORTS DemoResult runDemo(const DemoOptions& options);
+
 //! @}
 
 } // namespace augocc
