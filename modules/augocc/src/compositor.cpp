@@ -43,7 +43,7 @@ Camera supersampledCamera(const Camera& camera, int factor)
 }
 
 Compositor::Params::Params()
-    : supersample(3), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2)
+    : supersample(3), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2), lightRotation(Matx33d::eye())
 {
 }
 
@@ -152,7 +152,7 @@ public:
     Params getParams() const CV_OVERRIDE { return params_; }
     void setParams(const Params& p) CV_OVERRIDE
     {
-        if (p.cullBackFaces != params_.cullBackFaces)
+        if (p.cullBackFaces != params_.cullBackFaces || p.lightRotation != params_.lightRotation)
             dirty_ = true;
         if (p.supersample < 1 || p.supersample > 8)
             CV_Error(Error::StsBadArg, cv::format("Compositor: supersample must be in [1, 8], "
@@ -345,7 +345,8 @@ private:
             cv::parallel_for_(Range(0, (int)nv), [&](const Range& r) {
                 for (int i = r.start; i < r.end; i++)
                 {
-                    const Vec3f c = detail::shadeColor(m.material, m.normals[i],
+                    const Vec3f n = Vec3f(params_.lightRotation * Vec3d(m.normals[i]));
+                    const Vec3f c = detail::shadeColor(m.material, n,
                                                        hasColors ? m.colors[i] : Vec3f(1, 1, 1));
                     GpuVertex& g = verts[i];
                     g.x = m.vertices[i][0];

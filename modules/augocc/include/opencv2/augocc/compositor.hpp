@@ -67,6 +67,11 @@ public:
         int edgeRadius;
         //! Regularisation of that guided filter, guide in [0, 1] (default 1e-2).
         double edgeEps;
+        /** Rotation from the world of the reconstruction to the shading frame (y up) in which
+        the light of the shading convention is fixed (default identity: the world is y up, as
+        the synthesizer's). For a reconstruction, use the rows (right, up, back) of its
+        estimateGround() frame, so that the sun shines from above whatever the world's axes. */
+        Matx33d lightRotation;
     };
 
     static Ptr<Compositor> create(const Params& params);

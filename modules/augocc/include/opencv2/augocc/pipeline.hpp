@@ -39,6 +39,8 @@ struct CV_EXPORTS CompositeOptions
     String depthDir;
     String virtualLayerDir;    //!< if set: per frame `DIR/%04d.png`, BGRA, the virtual objects
     double fps = 0;            //!< output video frame rate (0: the input's)
+    //! Light frame (Compositor::Params::lightRotation); default: from estimateGround(rec).
+    bool lightFromGround = true;
     ProgressCallback progress; //!< called after every frame
 };
 
