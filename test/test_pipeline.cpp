@@ -193,6 +193,11 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
                   << " boundary " << acc.boundary / acc.frames << " band(vs ss1) "
                   << acc.band / acc.frames << " within8(vs ss4) " << acc4.within / acc.frames
                   << " band(vs ss4) " << acc4.band / acc.frames << std::endl;
+        // Issue 5: >= 99.5% of pixels within 8 grey levels with GT cameras and built clones
+        // (measured 99.97% at k = 1, 99.91% at k = 3). The 1 px boundary target is not met
+        // (1.25 px measured: the clones' outline error), so it is reported, not asserted.
+        const double kMinWithin = 0.995;
+        EXPECT_GE(acc.within / acc.frames, kMinWithin) << "k=" << k;
     }
 }
 
@@ -215,6 +220,7 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
     const V variants[] = {{0, 1, 0, 1e-3}, {0, 3, 0, 1e-3}, {0, 1, 2, 1e-3}, {0, 3, 2, 1e-3},
                           {0, 3, 3, 1e-3}, {0, 3, 2, 1e-2}, {0, 3, 2, 1e-4}, {1, 1, 0, 1e-3},
                           {1, 3, 0, 1e-3}, {1, 3, 2, 1e-3}};
+    std::vector<double> bandOf;
     for (const V& v : variants)
         {
             const int useExact = v.exact, k = v.k;
@@ -249,7 +255,14 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
             std::cout << (useExact ? "exact" : "built") << " k=" << k << " r=" << v.r << " eps="
                       << v.eps << " band(vs ss4) "
                       << band / n << " boundary " << bnd / n << std::endl;
+            bandOf.push_back(band / n);
         }
+    // Issue 5: soft edges cut the band error by >= 30% against the hard depth test. Met with
+    // exact clones (variants 7 vs 8: measured -49%); with built clones the clones' ~1 px outline
+    // error dominates (variants 0 vs 1: -6%), which is reported above, not asserted.
+    const double kMaxSoftOverHard = 0.7;
+    ASSERT_EQ(bandOf.size(), sizeof(variants) / sizeof(variants[0]));
+    EXPECT_LE(bandOf[8], kMaxSoftOverHard * bandOf[7]);
 }
 
 } // namespace
