@@ -16,34 +16,6 @@ namespace {
 using namespace cv;
 using namespace cv::augocc;
 
-// The demo's virtual objects (procedural dome behind the front building, tree in front of it),
-// placed by the scene helpers.
-VirtualScene demoScene()
-{
-    VirtualScene s;
-    s.path = "demo";
-    SceneObject dome;
-    dome.name = "dome";
-    dome.shape = "dome";
-    dome.meshes = proceduralShape("dome");
-    dome.placement = SceneObject::PLACE_BEHIND;
-    dome.anchor = "building";
-    dome.distance = 0.05;
-    dome.size = 0.6;
-    dome.offset = Vec3d(-0.72, 0, 0);
-    SceneObject tree;
-    tree.name = "tree";
-    tree.shape = "tree";
-    tree.meshes = proceduralShape("tree");
-    tree.placement = SceneObject::PLACE_IN_FRONT;
-    tree.anchor = "building";
-    tree.distance = 0.15;
-    tree.size = 0.6;
-    tree.offset = Vec3d(-0.2, 0, 0);
-    s.objects = {dome, tree};
-    return s;
-}
-
 // Clones that are the true geometry: each real object's mesh rendered (depth) through OSMesa at
 // any camera and size. The "perfect clone" of the edge-quality measurement.
 class MeshClones CV_FINAL : public CloneSet
@@ -149,7 +121,7 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
     SyntheticScene scene;
     synth->synthesize(scene);
     Ptr<CloneSet> clones = CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks);
-    const std::vector<Mesh> meshes = placeScene(demoScene(), scene.groundTruth, clones.get());
+    const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth, clones.get());
     for (int k : {1, 3})
     {
         Compositor::Params cp;
@@ -211,7 +183,7 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
     synth->synthesize(scene);
     Ptr<CloneSet> built = CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks);
     MeshClones exact(scene.objectNames, scene.objectMeshes);
-    const std::vector<Mesh> meshes = placeScene(demoScene(), scene.groundTruth, built.get());
+    const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth, built.get());
     Compositor::Params hp;
     hp.supersample = 1;
     Ptr<Compositor> ref = Compositor::create(hp);

@@ -535,10 +535,19 @@ RunResult runPipeline(const RunOptions& o)
 
 namespace {
 
+Mat alphaOf(const Mat& bgra)
+{
+    Mat a;
+    cv::extractChannel(bgra, a, 3);
+    return a;
+}
+
+} // namespace
+
 // The demo's virtual objects after the paper's Fig. 3: a dome behind the front building
 // (partly hidden by it, peeking out on its left, in the L-block's inner corner: on its right the
 // tower's clone cannot be carved under its cap) and a tree in front of it.
-VirtualScene demoScene(const String& path)
+VirtualScene demoVirtualScene(const String& path)
 {
     VirtualScene s;
     s.path = path;
@@ -563,15 +572,6 @@ VirtualScene demoScene(const String& path)
     s.objects = {dome, tree};
     return s;
 }
-
-Mat alphaOf(const Mat& bgra)
-{
-    Mat a;
-    cv::extractChannel(bgra, a, 3);
-    return a;
-}
-
-} // namespace
 
 DemoResult runDemo(const DemoOptions& o)
 {
@@ -599,7 +599,7 @@ DemoResult runDemo(const DemoOptions& o)
     const String masksDir = (dir / "input" / "masks").string();
     writeMasks(masksDir, scene.keyFrameMasks);
     res.scenePath = (dir / "scene.yml").string();
-    writeScene(res.scenePath, demoScene(res.scenePath));
+    writeScene(res.scenePath, demoVirtualScene(res.scenePath));
 
     RunOptions ro;
     ro.input = framesDir;

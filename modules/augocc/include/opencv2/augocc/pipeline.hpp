@@ -161,6 +161,11 @@ before and after, and scores the composite against the synthesizer's ground trut
 reconstruction aligned to the true world by alignReconstructions()). */
 CV_EXPORTS DemoResult runDemo(const DemoOptions& options);
 
+/** @brief The demo's virtual objects after the paper's Fig. 3: a dome behind the front building
+("building") and a tree in front of it, placed by the scene helpers.
+@param path the scene's path (meshes are procedural; the path names the scene in messages). */
+CV_EXPORTS VirtualScene demoVirtualScene(const String& path);
+
 //! @}
 
 } // namespace augocc
