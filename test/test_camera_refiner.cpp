@@ -3,6 +3,7 @@
 
 #include "test_precomp.hpp"
 #include "sfm_test_utils.hpp"
+#include "sfm_ceres.hpp"
 
 namespace opencv_test {
 namespace {
@@ -157,6 +158,72 @@ TEST(Augocc_OrthoCameraRefiner, multithread_reproducibility)
     {
         EXPECT_MAT_NEAR(a.cameras[i].R, b.cameras[i].R, kCeresThreadTol);
         EXPECT_MAT_NEAR(a.cameras[i].t, b.cameras[i].t, kCeresThreadTol);
+    }
+}
+
+// Evaluates a cost function at `params` and returns its residuals and every block's Jacobian.
+void evaluateCost(const ceres::CostFunction& cost, const std::vector<std::vector<double>>& params,
+                  std::vector<double>& residuals, std::vector<std::vector<double>>& jac)
+{
+    std::vector<const double*> p;
+    for (const std::vector<double>& b : params)
+        p.push_back(b.data());
+    residuals.assign(cost.num_residuals(), 0.0);
+    jac.assign(params.size(), std::vector<double>());
+    std::vector<double*> j;
+    for (size_t k = 0; k < params.size(); k++)
+    {
+        jac[k].assign(cost.num_residuals() * params[k].size(), 0.0);
+        j.push_back(jac[k].data());
+    }
+    ASSERT_TRUE(cost.Evaluate(p.data(), residuals.data(), j.data()));
+}
+
+void expectSameCost(const ceres::CostFunction& analytic, const ceres::CostFunction& autodiff,
+                    const std::vector<std::vector<double>>& params)
+{
+    std::vector<double> ra, rb;
+    std::vector<std::vector<double>> ja, jb;
+    evaluateCost(analytic, params, ra, ja);
+    evaluateCost(autodiff, params, rb, jb);
+    // Both are the same double-precision formula: agreement to rounding of values ~1e3.
+    const double kJacobianTol = 1e-9;
+    for (size_t i = 0; i < ra.size(); i++)
+        EXPECT_NEAR(ra[i], rb[i], kJacobianTol);
+    for (size_t k = 0; k < ja.size(); k++)
+        for (size_t i = 0; i < ja[k].size(); i++)
+            EXPECT_NEAR(ja[k][i], jb[k][i], kJacobianTol) << "block " << k << " entry " << i;
+}
+
+TEST(Augocc_OrthoCameraRefiner, analytic_jacobians_match_autodiff)
+{
+    RNG rng(7);
+    for (int trial = 0; trial < 20; trial++)
+    {
+        SCOPED_TRACE(trial);
+        Eigen::Quaterniond q(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0),
+                             rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+        q.normalize();
+        const std::vector<double> qv(q.coeffs().data(), q.coeffs().data() + 4);
+        const std::vector<double> X = {rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0),
+                                       rng.uniform(-5.0, 5.0)};
+        const double u = rng.uniform(0.0, 640.0), v = rng.uniform(0.0, 480.0);
+        const double s = rng.uniform(10.0, 40.0);
+        {
+            cv::augocc::detail::OrthoReprojectionCost analytic(u, v, 319.5, 239.5);
+            std::unique_ptr<ceres::CostFunction> ad(
+                cv::augocc::detail::OrthoReprojectionError::Create(u, v, 319.5, 239.5));
+            expectSameCost(analytic, *ad, {qv, {rng.uniform(-3.0, 3.0), rng.uniform(-3.0, 3.0)},
+                                           {s}, X});
+        }
+        {
+            cv::augocc::detail::PerspectiveStrengthCost analytic(u, v, 319.5, 239.5);
+            std::unique_ptr<ceres::CostFunction> ad(
+                cv::augocc::detail::PerspectiveStrengthError::Create(u, v, 319.5, 239.5));
+            expectSameCost(analytic, *ad, {qv, {rng.uniform(-3.0, 3.0), rng.uniform(-3.0, 3.0),
+                                           rng.uniform(-3.0, 3.0)}, {s},
+                                           {rng.uniform(-0.02, 0.02)}, X});
+        }
     }
 }
 

@@ -81,7 +81,7 @@ public:
         double lossScale;        //!< pixels at which the robust loss bends (default 2.0)
         bool perFrameScale;      //!< FULL_BA: one zoom per frame instead of one (default false)
         int maxIterations;       //!< Levenberg-Marquardt iterations at most (default 50)
-        double functionTolerance;//!< Ceres function_tolerance (default 1e-9)
+        double functionTolerance;//!< Ceres function_tolerance (default 1e-6)
     };
 
     static Ptr<OrthoCameraRefiner> create(const Params& params);
