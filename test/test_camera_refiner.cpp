@@ -259,6 +259,30 @@ TEST(Augocc_SfmSynth, scaled_orthographic_full_tracks)
     EXPECT_LT(rep.orthographic.rms, kFullRmsRatio * noise);
 }
 
+TEST(Augocc_SfmSynth, depth_reversal_resolved_by_dominant_plane)
+{
+    // Scaled orthography: the depth-reversed twin projects to the same pixels; recoverCameras
+    // picks the one with the scene in front of its dominant plane (the ground). Without the
+    // prior the factorization's arbitrary choice gave the twin (23 deg off) for seeds 1 and 5.
+    for (int seed : {1, 2, 5})
+    {
+        SCOPED_TRACE(cv::format("seed %d", seed));
+        SceneSynthesizer::Params sp;
+        sp.frames = 30;
+        sp.seed = (uint64)seed;
+        if (seed == 5)
+        {
+            sp.elevationDegrees = 60;
+            sp.orbitDegrees = 70;
+        }
+        SyntheticScene scene;
+        SceneSynthesizer::create(sp)->synthesize(scene);
+        const Reconstruction rec = recoverCameras(scene.tracks);
+        const CameraComparison c = compareCameras(rec, scene.groundTruth, false);
+        EXPECT_LT(c.meanRotationDeg, kFullRotDeg);
+    }
+}
+
 TEST(Augocc_SfmSynth, partial_and_outlier_tracks)
 {
     const SyntheticScene scene = synthesize(SCALED_ORTHOGRAPHIC, 0.4, 0.05);
