@@ -19,6 +19,13 @@ FeatureTracker::Params::Params()
 
 namespace {
 
+// Pyramid levels above the base searched by Lucas-Kanade for a track with a velocity (around its
+// predicted position: +-14 px with the 15x15 window) and by the backward (checking) pass; the
+// per-level cost is the same at every level (one window per point), so the 4 levels of a plain
+// pyramidal search cost twice as much. Tracks that fail the short search get the full pyramid.
+const int kPredictedLevels = 1;
+const int kBackwardLevels = 1;
+
 // One tracking session: frames are fed one at a time.
 class TrackingSession
 {
@@ -35,9 +42,9 @@ public:
                 CV_Error(Error::StsBadArg, "exclusion mask must be 8-bit single channel");
             excluded_ = p_.exclusionMask > 127;
         }
-        // OpenCV's 30 iterations / 0.01 px and a 15x15 window. An 11x11 window with 10 / 0.03
-        // was twice as fast and as accurate on tracks.yml figures, but `augocc demo` then
-        // recovered cameras 23 degrees off (drifting tracks on the ground texture): measured.
+        // OpenCV's 30 iterations / 0.01 px and a 15x15 window. (An 11x11 window with 10 / 0.03
+        // once gave `augocc demo` cameras 23 degrees off; that was the orthographic
+        // depth-reversal twin, picked by chance, not tracking: recoverCameras now chooses it.)
         criteria_ = TermCriteria(TermCriteria::COUNT | TermCriteria::EPS, 30, 0.01);
     }
 
@@ -102,28 +109,83 @@ private:
 
     void trackLive(const std::vector<Mat>& pyr)
     {
-        std::vector<Point2f> prev(live_.size()), next, back;
-        for (size_t i = 0; i < live_.size(); i++)
-            prev[i] = tracks_[live_[i]].pts.back();
-        std::vector<uchar> st, stBack;
-        std::vector<float> err;
-        calcOpticalFlowPyrLK(prevPyr_, pyr, prev, next, st, err, p_.winSize, p_.levels,
-                             criteria_);
-        back = prev;
-        calcOpticalFlowPyrLK(pyr, prevPyr_, next, back, stBack, err, p_.winSize, p_.levels,
-                             criteria_, OPTFLOW_USE_INITIAL_FLOW);
-        std::vector<int> still;
-        still.reserve(live_.size());
-        const double fb2 = p_.fbThreshold * p_.fbThreshold;
-        for (size_t i = 0; i < live_.size(); i++)
+        const int n = (int)live_.size();
+        prev_.resize(n);
+        next_.resize(n);
+        std::vector<int> predicted, full;
+        for (int i = 0; i < n; i++)
         {
-            const Point2f d = back[i] - prev[i];
-            if (!st[i] || !stBack[i] || d.dot(d) > fb2 || !usable(next[i]))
+            const std::vector<Point2f>& pts = tracks_[live_[i]].pts;
+            prev_[i] = pts.back();
+            next_[i] = pts.back();
+            if (pts.size() >= 2)
+            {
+                // Constant-velocity prediction: the search starts where the track is expected
+                // and only has to cover the change of motion, a short pyramid.
+                next_[i] = 2 * pts.back() - pts[pts.size() - 2];
+                predicted.push_back(i);
+            }
+            else
+            {
+                full.push_back(i);
+            }
+        }
+        std::vector<uchar> ok(n, 0);
+        trackSubset(pyr, predicted, std::min(p_.levels, kPredictedLevels), ok);
+        // New tracks and those the short search lost (the motion changed): the full pyramid,
+        // from no motion, as a plain pyramidal tracker would.
+        for (int i : predicted)
+        {
+            if (!ok[i])
+            {
+                next_[i] = prev_[i];
+                full.push_back(i);
+            }
+        }
+        trackSubset(pyr, full, p_.levels, ok);
+        std::vector<int> still;
+        still.reserve(n);
+        for (int i = 0; i < n; i++)
+        {
+            if (!ok[i] || !usable(next_[i]))
                 continue;
-            tracks_[live_[i]].pts.push_back(next[i]);
+            tracks_[live_[i]].pts.push_back(next_[i]);
             still.push_back(live_[i]);
         }
         live_.swap(still);
+    }
+
+    // Forward Lucas-Kanade of the live tracks idx from prev_ (search started at next_, result
+    // in next_) over `levels` pyramid levels, then the forward-backward check; ok[i] = passed.
+    void trackSubset(const std::vector<Mat>& pyr, const std::vector<int>& idx, int levels,
+                     std::vector<uchar>& ok)
+    {
+        if (idx.empty())
+            return;
+        const size_t m = idx.size();
+        from_.resize(m);
+        to_.resize(m);
+        for (size_t k = 0; k < m; k++)
+        {
+            from_[k] = prev_[idx[k]];
+            to_[k] = next_[idx[k]];
+        }
+        calcOpticalFlowPyrLK(prevPyr_, pyr, from_, to_, st_, err_, p_.winSize, levels,
+                             criteria_, OPTFLOW_USE_INITIAL_FLOW);
+        // The backward pass starts at the original point: a good track returns there within
+        // the threshold, a drifted one converges to where its new window came from; that
+        // search needs no more than kBackwardLevels levels whatever the motion.
+        back_ = from_;
+        calcOpticalFlowPyrLK(pyr, prevPyr_, to_, back_, stBack_, err_, p_.winSize,
+                             std::min(levels, kBackwardLevels), criteria_,
+                             OPTFLOW_USE_INITIAL_FLOW);
+        const double fb2 = p_.fbThreshold * p_.fbThreshold;
+        for (size_t k = 0; k < m; k++)
+        {
+            const Point2f d = back_[k] - from_[k];
+            next_[idx[k]] = to_[k];
+            ok[idx[k]] = st_[k] && stBack_[k] && d.dot(d) <= fb2;
+        }
     }
 
     void detect(const Mat& gray)
@@ -164,6 +226,9 @@ private:
     Mat excluded_;
     TermCriteria criteria_;
     std::vector<Mat> prevPyr_;
+    std::vector<Point2f> prev_, next_, from_, to_, back_;   // buffers of trackLive
+    std::vector<uchar> st_, stBack_;
+    std::vector<float> err_;
     std::vector<TrackRec> tracks_;
     std::vector<int> live_;
     int frameIndex_ = 0;

@@ -36,7 +36,7 @@ public:
         double quality;         //!< Shi-Tomasi quality level, relative to the best (0.01)
         double minDistance;     //!< minimum distance between tracks, pixels (default 8)
         int blockSize;          //!< Shi-Tomasi gradient window (default 3)
-        Size winSize;           //!< Lucas-Kanade window (default 11 x 11)
+        Size winSize;           //!< Lucas-Kanade window (default 15 x 15)
         int levels;             //!< pyramid levels above the base (default 3)
         double fbThreshold;     //!< forward-backward error above which a track ends, px (1.0)
         double redetectRatio;   //!< re-detect when live tracks < this * maxTracks (0.9)
