@@ -25,6 +25,8 @@ namespace {
 // pyramidal search cost twice as much. Tracks that fail the short search get the full pyramid.
 const int kPredictedLevels = 1;
 const int kBackwardLevels = 1;
+// Slices of the tracked points handed to the threads (a fixed number: thread-independent).
+const size_t kLkChunks = 16;
 
 // One tracking session: frames are fed one at a time.
 class TrackingSession
@@ -170,21 +172,43 @@ private:
             from_[k] = prev_[idx[k]];
             to_[k] = next_[idx[k]];
         }
-        calcOpticalFlowPyrLK(prevPyr_, pyr, from_, to_, st_, err_, p_.winSize, levels,
-                             criteria_, OPTFLOW_USE_INITIAL_FLOW);
-        // The backward pass starts at the original point: a good track returns there within
-        // the threshold, a drifted one converges to where its new window came from; that
-        // search needs no more than kBackwardLevels levels whatever the motion.
-        back_ = from_;
-        calcOpticalFlowPyrLK(pyr, prevPyr_, to_, back_, stBack_, err_, p_.winSize,
-                             std::min(levels, kBackwardLevels), criteria_,
-                             OPTFLOW_USE_INITIAL_FLOW);
-        const double fb2 = p_.fbThreshold * p_.fbThreshold;
+        // OpenCV 4.6 runs one calcOpticalFlowPyrLK call on one thread (measured: the same time
+        // with 1 or 2 threads); every point is tracked independently, so fixed slices of the
+        // points are tracked in parallel: results do not depend on the number of threads.
+        std::vector<uchar> pass(m, 0);
+        const int chunks = (int)std::min<size_t>(m, kLkChunks);
+        const std::vector<Mat>& prevPyr = prevPyr_;
+        parallel_for_(Range(0, chunks), [&](const Range& r) {
+            std::vector<Point2f> from, to, back;
+            std::vector<uchar> st, stBack;
+            std::vector<float> err;
+            for (int c = r.start; c < r.end; c++)
+            {
+                const size_t a = m * c / chunks, b = m * (c + 1) / chunks;
+                from.assign(from_.begin() + a, from_.begin() + b);
+                to.assign(to_.begin() + a, to_.begin() + b);
+                calcOpticalFlowPyrLK(prevPyr, pyr, from, to, st, err, p_.winSize, levels,
+                                     criteria_, OPTFLOW_USE_INITIAL_FLOW);
+                // The backward pass starts at the original point: a good track returns there
+                // within the threshold, a drifted one converges to where its new window came
+                // from; that search needs no more than kBackwardLevels levels.
+                back = from;
+                calcOpticalFlowPyrLK(pyr, prevPyr, to, back, stBack, err, p_.winSize,
+                                     std::min(levels, kBackwardLevels), criteria_,
+                                     OPTFLOW_USE_INITIAL_FLOW);
+                const double fb2 = p_.fbThreshold * p_.fbThreshold;
+                for (size_t k = a; k < b; k++)
+                {
+                    const Point2f d = back[k - a] - from[k - a];
+                    to_[k] = to[k - a];
+                    pass[k] = st[k - a] && stBack[k - a] && d.dot(d) <= fb2;
+                }
+            }
+        });
         for (size_t k = 0; k < m; k++)
         {
-            const Point2f d = back_[k] - from_[k];
             next_[idx[k]] = to_[k];
-            ok[idx[k]] = st_[k] && stBack_[k] && d.dot(d) <= fb2;
+            ok[idx[k]] = pass[k];
         }
     }
 
@@ -226,9 +250,7 @@ private:
     Mat excluded_;
     TermCriteria criteria_;
     std::vector<Mat> prevPyr_;
-    std::vector<Point2f> prev_, next_, from_, to_, back_;   // buffers of trackLive
-    std::vector<uchar> st_, stBack_;
-    std::vector<float> err_;
+    std::vector<Point2f> prev_, next_, from_, to_;   // buffers of trackLive
     std::vector<TrackRec> tracks_;
     std::vector<int> live_;
     int frameIndex_ = 0;
