@@ -135,6 +135,43 @@ VoxelProjector VoxelGrid::projector(const Camera& camera, Size imageSize) const
     return p;
 }
 
+void quadrantDistance(const Mat& label, const Rect& roi, int sx, int sy, Mat& dist)
+{
+    CV_CheckTypeEQ(label.type(), CV_8UC1, "label image");
+    CV_Assert(dist.type() == CV_8SC1 && dist.size() == label.size());
+    CV_Assert((roi & Rect(Point(0, 0), label.size())) == roi);
+    const int kSat = 127;
+    const int xs = sx > 0 ? roi.x + roi.width - 1 : roi.x, xe = sx > 0 ? roi.x - 1 : roi.x + roi.width;
+    const int ys = sy > 0 ? roi.y + roi.height - 1 : roi.y, ye = sy > 0 ? roi.y - 1 : roi.y + roi.height;
+    const int dx = -sx, dy = -sy;  // raster order: from the far corner back
+    for (int y = ys; y != ye; y += dy)
+    {
+        const uchar* l = label.ptr<uchar>(y);
+        schar* d = dist.ptr<schar>(y);
+        const bool hasPrev = y != ys;
+        const uchar* lp = hasPrev ? label.ptr<uchar>(y + sy) : nullptr;
+        const schar* dp = hasPrev ? dist.ptr<schar>(y + sy) : nullptr;
+        for (int x = xs; x != xe; x += dx)
+        {
+            const bool a = l[x] != 0;
+            int best = kSat;
+            const bool hasNext = x != xs;
+            // Neighbours (x + sx, y), (x, y + sy), (x + sx, y + sy): already done.
+            if (hasNext)
+                best = std::min(best, (l[x + sx] != 0) != a ? 1 : std::abs((int)d[x + sx]) + 1);
+            if (hasPrev)
+            {
+                best = std::min(best, (lp[x] != 0) != a ? 1 : std::abs((int)dp[x]) + 1);
+                if (hasNext)
+                    best = std::min(best, (lp[x + sx] != 0) != a ? 1
+                                                             : std::abs((int)dp[x + sx]) + 1);
+            }
+            best = std::min(best, kSat);
+            d[x] = (schar)(a ? best : -best);
+        }
+    }
+}
+
 CarveView VoxelGrid::carveView(const Camera& camera, const Mat& keep) const
 {
     CV_CheckTypeEQ(keep.type(), CV_8UC1, "keep mask");
@@ -145,16 +182,88 @@ CarveView VoxelGrid::carveView(const Camera& camera, const Mat& keep) const
     v.pad = 4;
     Mat k01 = keep != 0;
     copyMakeBorder(k01, v.keep, v.pad, v.pad, v.pad, v.pad, BORDER_CONSTANT, Scalar(255));
+    const Rect all(Point(0, 0), v.keep.size());
+    // The distances are needed only where footprints fall: the grid's image bounds (not clipped
+    // to the image), in padded coordinates.
+    v.roi = all;
+    {
+        int x0 = INT_MAX, y0 = INT_MAX, x1 = INT_MIN, y1 = INT_MIN;
+        bool ok = true;
+        for (int c = 0; c < 8 && ok; c++)
+        {
+            int a0 = 0, a1 = 0, b0 = 0, b1 = 0;
+            double z = 0;
+            ok = v.proj.footprint(c & 1 ? dims[0] - 1 : 0, c & 2 ? dims[1] - 1 : 0,
+                                  c & 4 ? dims[2] - 1 : 0, a0, a1, b0, b1, z);
+            x0 = std::min(x0, a0 - 2);
+            y0 = std::min(y0, b0 - 2);
+            x1 = std::max(x1, a1 + 2);
+            y1 = std::max(y1, b1 + 2);
+        }
+        if (ok)
+            v.roi = Rect(Point(x0 + v.pad, y0 + v.pad), Point(x1 + v.pad + 1, y1 + v.pad + 1)) & all;
+    }
+    v.dist.create(v.keep.size(), CV_8SC1);
+    v.dist.setTo(Scalar(1));
+    if (v.roi.empty())
+        return v;
+    if (v.proj.affine)
+    {
+        // Every row steps by (M00, M10) per voxel: only the quadrant ahead matters.
+        v.quadrant = true;
+        v.sx = v.proj.M(0, 0) >= 0 ? 1 : -1;
+        v.sy = v.proj.M(1, 0) >= 0 ? 1 : -1;
+        v.rad = (int)std::floor(0.5 + std::max(v.proj.ruAffine, v.proj.rvAffine));
+        quadrantDistance(v.keep, v.roi, v.sx, v.sy, v.dist);
+        // Outside the roi: "kept, q unknown" (forces the exact test), no neighbour outside.
+        v.walk.create(v.keep.size(), CV_8UC2);
+        v.walk.setTo(Scalar(0, 0));
+        const int W = v.keep.cols, H = v.keep.rows;
+        for (int y = v.roi.y; y < v.roi.y + v.roi.height; y++)
+        {
+            const schar* d = v.dist.ptr<schar>(y);
+            const uchar* k = v.keep.ptr<uchar>(y);
+            const uchar* ku = y > 0 ? v.keep.ptr<uchar>(y - 1) : nullptr;
+            const uchar* kd = y + 1 < H ? v.keep.ptr<uchar>(y + 1) : nullptr;
+            const int qy = y - v.sy * v.rad;
+            const bool qyIn = qy >= v.roi.y && qy < v.roi.y + v.roi.height;
+            const schar* dq = qyIn ? v.dist.ptr<schar>(qy) : nullptr;
+            uchar* w = v.walk.ptr<uchar>(y);
+            for (int x = v.roi.x; x < v.roi.x + v.roi.width; x++)
+            {
+                if (!k[x])
+                {
+                    w[2 * x] = (uchar)d[x];
+                    w[2 * x + 1] = 0;
+                    continue;
+                }
+                const int qx = x - v.sx * v.rad;
+                int sq = 0;
+                if (dq && qx >= v.roi.x && qx < v.roi.x + v.roi.width)
+                    sq = std::max((int)dq[qx], 0);
+                // Neighbours off the padded image are unknown (kept).
+                auto out = [&](const uchar* r, int xx) {
+                    return r && xx >= 0 && xx < W && !r[xx];
+                };
+                const int nb = out(ku, x - 1) | out(ku, x) << 1 | out(ku, x + 1) << 2 |
+                               out(k, x - 1) << 3 | out(k, x + 1) << 4 |
+                               out(kd, x - 1) << 5 | out(kd, x) << 6 | out(kd, x + 1) << 7;
+                w[2 * x] = (uchar)(schar)sq;
+                w[2 * x + 1] = (uchar)nb;
+            }
+        }
+        return v;
+    }
     // Signed, saturated distance in one byte per pixel (one cache line serves both the label and
     // the distance): +D where kept, -D outside; skips are capped at 127 pixels.
-    const Mat d16 = labelDistance(v.keep);
-    v.dist.create(v.keep.size(), CV_8SC1);
-    for (int y = 0; y < v.keep.rows; y++)
+    const Mat kr = v.keep(v.roi);
+    const Mat d16 = labelDistance(kr);
+    for (int y = 0; y < kr.rows; y++)
     {
         const ushort* d = d16.ptr<ushort>(y);
-        const uchar* k = v.keep.ptr<uchar>(y);
-        schar* o = v.dist.ptr<schar>(y);
-        for (int x = 0; x < v.keep.cols; x++)
+        const uchar* k = kr.ptr<uchar>(y);
+        schar* o = v.dist.ptr<schar>(y + v.roi.y) + v.roi.x;
+        for (int x = 0; x < kr.cols; x++)
         {
             const int c = std::min((int)d[x], 127);
             o[x] = (schar)(k[x] ? c : -c);
@@ -184,41 +293,61 @@ bool VoxelGrid::footprintKept(const CarveView& view, int i, int j, int k) const
 
 namespace {
 
-// Carves one voxel row (j, k) with one view. Walks the alive voxels, and uses the chessboard
-// distance of the pixel under the current voxel to skip every following voxel that provably has
-// the same outcome: moving the projected centre by delta (L-inf) moves its rounded pixel by at
-// most floor(delta) + 1, and footprints lie within `rad` of that pixel.
-void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* row)
+// VoxelGrid::footprintKept, inlined for the row walk.
+inline bool footprintKeptFast(const CarveView& view, int i, int j, int k)
+{
+    int x0, x1, y0, y1;
+    double z;
+    if (!view.proj.footprint(i, j, k, x0, x1, y0, y1, z))
+        return true;
+    const int W = view.keep.cols, H = view.keep.rows;
+    x0 = std::max(x0 + view.pad, 0);
+    x1 = std::min(x1 + view.pad, W - 1);
+    y0 = std::max(y0 + view.pad, 0);
+    y1 = std::min(y1 + view.pad, H - 1);
+    for (int y = y0; y <= y1; y++)
+    {
+        const uchar* r = view.keep.ptr<uchar>(y);
+        for (int x = x0; x <= x1; x++)
+            if (!r[x])
+                return false;
+    }
+    return true;
+}
+
+// Carves voxels lo..hi of one voxel row (j, k) with one view. Walks the alive voxels, and uses the
+// chessboard distance of the pixel under the current voxel to skip every following voxel that
+// provably has the same outcome: moving the projected centre by delta (L-inf) moves its rounded
+// pixel by at most floor(delta) + 1, and footprints lie within `rad` of that pixel.
+void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* row, int lo, int hi)
 {
     const VoxelProjector& P = view.proj;
     const int nx = g.dims[0];
-    const Vec3d A(P.M(0, 1) * j + P.M(0, 2) * k + P.c[0], P.M(1, 1) * j + P.M(1, 2) * k + P.c[1],
-                  P.M(2, 1) * j + P.M(2, 2) * k + P.c[2]);
-    const Vec3d B(P.M(0, 0), P.M(1, 0), P.M(2, 0));
+    const double A0 = P.M(0, 1) * j + P.M(0, 2) * k + P.c[0];
+    const double A1 = P.M(1, 1) * j + P.M(1, 2) * k + P.c[1];
+    const double A2 = P.M(2, 1) * j + P.M(2, 2) * k + P.c[2];
+    const double B0 = P.M(0, 0), B1 = P.M(1, 0), B2 = P.M(2, 0);
     double step, rmax;
     if (P.affine)
     {
-        step = std::max(std::abs(B[0]), std::abs(B[1]));
+        step = std::max(std::abs(B0), std::abs(B1));
         rmax = std::max(P.ruAffine, P.rvAffine);
     }
     else
     {
-        const double w0 = A[2], w1 = A[2] + B[2] * (nx - 1);
+        const double w0 = A2, w1 = A2 + B2 * (nx - 1);
         const double wmin = std::min(w0, w1);
         if (!(wmin > 1e-12))
             return;  // part of the row is behind the camera: no evidence, keep
         // u(i) = (A0 + B0 i) / (A2 + B2 i): du/di = (B0 A2 - A0 B2) / w^2, largest at wmin.
-        step = std::max(std::abs(B[0] * A[2] - A[0] * B[2]),
-                        std::abs(B[1] * A[2] - A[1] * B[2])) / (wmin * wmin);
+        step = std::max(std::abs(B0 * A2 - A0 * B2), std::abs(B1 * A2 - A1 * B2)) /
+               (wmin * wmin);
         double r = 0;
         for (int e = 0; e < 2; e++)
         {
-            int x0, x1, y0, y1;
-            double z;
             const int i = e == 0 ? 0 : nx - 1;
-            const double w = A[2] + B[2] * i;
-            const double u = (A[0] + B[0] * i) / w, v = (A[1] + B[1] * i) / w;
-            (void)x0; (void)x1; (void)y0; (void)y1; (void)z;
+            const double w = A2 + B2 * i;
+            const double u = (A0 + B0 * i) / w, v = (A1 + B1 * i) / w;
             const double ru = 0.5 / w * (std::abs(P.M(0, 0) - u * P.M(2, 0)) +
                                          std::abs(P.M(0, 1) - u * P.M(2, 1)) +
                                          std::abs(P.M(0, 2) - u * P.M(2, 2)));
@@ -230,24 +359,32 @@ void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* ro
         rmax = r * kPerspectiveRadiusMargin;
     }
     step = std::max(step, 1e-9);
+    const double inv = 1.0 / step;
     const int rad = (int)std::floor(0.5 + rmax);
     const int pad = view.pad;
     const int W = view.keep.cols, H = view.keep.rows;
-    int i = 0;
-    while (i < nx)
+    const schar* dist = view.dist.ptr<schar>();
+    const size_t dstep = view.dist.step[0];
+    const int rx0 = view.roi.x, ry0 = view.roi.y;
+    const int rx1 = view.roi.x + view.roi.width, ry1 = view.roi.y + view.roi.height;
+    const uchar* walk = view.quadrant ? view.walk.ptr<uchar>() : nullptr;
+    const size_t wstep = view.quadrant ? view.walk.step[0] : 0;
+    const int end = hi + 1;
+    int i = lo;
+    while (i < end)
     {
         if (!row[i])
         {
-            const void* nxt = std::memchr(row + i, 1, (size_t)(nx - i));
+            const void* nxt = std::memchr(row + i, 1, (size_t)(end - i));
             if (!nxt)
                 break;
             i = (int)((const uchar*)nxt - row);
             continue;
         }
-        double u = A[0] + B[0] * i, v = A[1] + B[1] * i;
+        double u = A0 + B0 * i, v = A1 + B1 * i;
         if (!P.affine)
         {
-            const double iw = 1.0 / (A[2] + B[2] * i);
+            const double iw = 1.0 / (A2 + B2 * i);
             u *= iw;
             v *= iw;
         }
@@ -257,35 +394,106 @@ void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* ro
             // Off the padded image: unknown, kept; skip while the footprint stays off the image
             // or in the keep border.
             const int dOut = std::max(std::max(-px, px - (W - 1)), std::max(-py, py - (H - 1)));
-            const int n = (int)std::floor((dOut + pad - 1 - rad - kSkipEps) / step);
+            const int n = (int)((dOut + pad - 1 - rad - kSkipEps) * inv);
             i += std::max(n, 0) + 1;
             continue;
         }
+        if (view.quadrant)
+        {
+            // The rest of the row stays in the quadrant ahead of this pixel (rounding is
+            // monotonic). Outside: the next n voxels' pixels are within floor(n step) + 1 of it,
+            // all outside. Kept: their footprints lie in the quadrant ahead of q, this pixel moved
+            // back by rad, within floor(n step) + 1 + 2 rad of q.
+            if (px < rx0 || py < ry0 || px >= rx1 || py >= ry1)
+            {
+                // Not reached (footprints lie in the roi), but stay exact if it were.
+                if (!footprintKeptFast(view, i, j, k))
+                    row[i] = 0;
+                i++;
+                continue;
+            }
+            const int rad1 = view.rad;
+            const uchar* wp = walk + (size_t)py * wstep + 2 * px;
+            const int sv = (schar)wp[0];
+            if (sv < 0)
+            {
+                const int n = std::max((int)((-sv - 1 - kSkipEps) * inv), 0);
+                const int e = std::min(end, i + n + 1);
+                std::memset(row + i, 0, (size_t)(e - i));
+                i = e;
+                continue;
+            }
+            if (sv > 2 * rad1)
+            {
+                const int n = (int)((sv - 1 - 2 * rad1 - kSkipEps) * inv);
+                i += std::max(n, 0) + 1;
+                continue;
+            }
+            // Exact test; from the neighbour mask when the footprint is within one pixel.
+            int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+            double z = 0;
+            view.proj.footprint(i, j, k, x0, x1, y0, y1, z);
+            x0 -= px - pad;
+            x1 -= px - pad;
+            y0 -= py - pad;
+            y1 -= py - pad;
+            bool kept;
+            if (x0 >= -1 && x1 <= 1 && y0 >= -1 && y1 <= 1)
+            {
+                int m9 = 0;
+                for (int yy = y0; yy <= y1; yy++)
+                    for (int xx = x0; xx <= x1; xx++)
+                        m9 |= 1 << ((yy + 1) * 3 + xx + 1);
+                const int m8 = (m9 & 15) | ((m9 >> 5) << 4);
+                kept = (wp[1] & m8) == 0;  // the centre is kept (sv >= 0)
+            }
+            else
+                kept = footprintKeptFast(view, i, j, k);
+            if (!kept)
+                row[i] = 0;
+            i++;
+            continue;
+        }
         // One signed byte per pixel: +D in the keep region, -D outside (see CarveView).
-        const int sd = view.dist.at<schar>(py, px);
-        const int D = std::abs(sd);
+        const int sd = dist[(size_t)py * dstep + px];
         if (sd > 0)
         {
-            if (D > rad)
+            if (sd > rad)
             {
-                const int n = (int)std::floor((D - 1 - rad - kSkipEps) / step);
+                const int n = (int)((sd - 1 - rad - kSkipEps) * inv);
                 i += std::max(n, 0) + 1;
             }
             else
             {
-                if (!g.footprintKept(view, i, j, k))
+                if (!footprintKeptFast(view, i, j, k))
                     row[i] = 0;
                 i++;
             }
         }
         else
         {
-            const int n = std::max((int)std::floor((D - 1 - kSkipEps) / step), 0);
-            const int end = std::min(nx, i + n + 1);
-            std::memset(row + i, 0, (size_t)(end - i));
-            i = end;
+            const int n = std::max((int)((-sd - 1 - kSkipEps) * inv), 0);
+            const int e = std::min(end, i + n + 1);
+            std::memset(row + i, 0, (size_t)(e - i));
+            i = e;
         }
     }
+}
+
+// Last alive voxel of row[lo..hi], or lo - 1 when none.
+inline int lastAlive(const uchar* row, int lo, int hi)
+{
+    while (hi >= lo + 7)
+    {
+        uint64_t w;
+        std::memcpy(&w, row + hi - 7, 8);
+        if (w)
+            break;
+        hi -= 8;
+    }
+    while (hi >= lo && !row[hi])
+        hi--;
+    return hi;
 }
 
 } // namespace
@@ -294,14 +502,60 @@ void VoxelGrid::carve(const std::vector<CarveView>& views)
 {
     if (views.empty() || data.empty())
         return;
-    const int ny = dims[1];
+    const int nx = dims[0], ny = dims[1];
+    // The views that carve most go first, so that most rows die (or shrink) early: the fraction of
+    // outside pixels in the grid's image bounds. The order does not change the result (carving is
+    // an intersection).
+    std::vector<std::pair<double, int> > strength(views.size());
+    for (size_t q = 0; q < views.size(); q++)
+    {
+        const CarveView& v = views[q];
+        const Rect roi = (imageBounds(v.proj) + Point(v.pad, v.pad)) &
+                         Rect(Point(0, 0), v.keep.size());
+        const double out = roi.area() > 0 ? 1.0 - countNonZero(v.keep(roi)) / (double)roi.area()
+                                          : 0.0;
+        strength[q] = std::make_pair(-out, (int)q);
+    }
+    std::sort(strength.begin(), strength.end());
+    // Per z slice, view by view (the view's maps stay in cache over the slice), each row only over
+    // its alive span; a row that dies needs no further view. Rows are independent, so the result
+    // does not depend on the partition into threads.
     parallel_for_(Range(0, dims[2]), [&](const Range& r) {
-        // View-major within a slice: consecutive rows project to neighbouring image rows, so the
-        // view's label and distance images stay in cache.
+        std::vector<int> lo(ny), hi(ny);
         for (int k = r.start; k < r.end; k++)
-            for (const CarveView& v : views)
+        {
+            for (int j = 0; j < ny; j++)
+            {
+                const uchar* row = &data[index(0, j, k)];
+                const void* first = std::memchr(row, 1, (size_t)nx);
+                lo[j] = first ? (int)((const uchar*)first - row) : nx;
+                hi[j] = first ? lastAlive(row, lo[j], nx - 1) : -1;
+            }
+            for (const auto& s : strength)
+            {
+                const CarveView& view = views[s.second];
+                bool any = false;
                 for (int j = 0; j < ny; j++)
-                    carveRow(*this, v, j, k, &data[index(0, j, k)]);
+                {
+                    if (lo[j] > hi[j])
+                        continue;
+                    uchar* row = &data[index(0, j, k)];
+                    carveRow(*this, view, j, k, row, lo[j], hi[j]);
+                    const void* f = std::memchr(row + lo[j], 1, (size_t)(hi[j] - lo[j] + 1));
+                    if (!f)
+                    {
+                        lo[j] = nx;
+                        hi[j] = -1;
+                        continue;
+                    }
+                    lo[j] = (int)((const uchar*)f - row);
+                    hi[j] = lastAlive(row, lo[j], hi[j]);
+                    any = true;
+                }
+                if (!any)
+                    break;
+            }
+        }
     });
 }
 

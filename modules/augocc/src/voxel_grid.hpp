@@ -107,9 +107,27 @@ struct CarveView
     VoxelProjector proj;
     Mat keep;   //!< CV_8U, padded
     Mat dist;   //!< CV_8S, padded: +D kept, -D outside, D the chessboard distance to the other
-                //!< label saturated at 127
+                //!< label saturated at 127 (only over `roi`; +1 elsewhere, which forces exact tests)
     int pad = 0;
+    Rect roi;   //!< padded coordinates: every voxel footprint of the grid lies in it
+    /** Affine views: voxel rows all move the same way in the image, (sx, sy) the signs of the
+    step. `dist` then counts only the other label's pixels in the quadrant ahead
+    {(x' - x) sx >= 0, (y' - y) sy >= 0}, which the rest of the row can reach (quadrantDistance). */
+    bool quadrant = false;
+    int sx = 1, sy = 1;
+    int rad = 0;  //!< quadrant views: footprints lie within rad pixels of the centre's pixel
+    /** Quadrant views: per pixel of `roi` two bytes, what the row walk needs from one cache line.
+    Byte 0 (signed): outside pixels -D, D the quadrant distance to a kept pixel; kept pixels the
+    quadrant distance of q = (x - sx rad, y - sy rad) to an outside pixel (0 when q is outside).
+    Byte 1: which of the 8 neighbours are outside (bit order row by row, the centre left out). */
+    Mat walk;
 };
+
+/** @brief Chessboard distance of every pixel of `roi` to the nearest pixel of the other label in
+the quadrant {(x' - x) sx >= 0, (y' - y) sy >= 0} of `roi`, saturated at 127 and signed (+ where
+`label` is nonzero): one raster pass from the quadrant's far corner. Exact: a chessboard path
+between two pixels of a rectangle can stay in it and move monotonically. */
+CV_EXPORTS void quadrantDistance(const Mat& label, const Rect& roi, int sx, int sy, Mat& dist);
 
 //! Chessboard distance of every pixel to the nearest pixel of the other label (CV_16U).
 CV_EXPORTS Mat labelDistance(const Mat& label);
