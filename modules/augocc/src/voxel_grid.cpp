@@ -6,6 +6,7 @@
 
 #include <climits>
 #include <cstring>
+#include <memory>
 
 namespace cv {
 namespace augocc {
@@ -16,6 +17,8 @@ namespace {
 // Margin subtracted from distances before skipping, so that rounding never lets a skip cross a
 // label change (distances are integers; steps are in pixels).
 const double kSkipEps = 1e-6;
+// Affine views: rows walked in lockstep by one thread (independent walks overlap cache misses).
+const int kLanes = 4;
 // Perspective rows: the footprint radius changes along a row; its bound from the two ends is
 // widened by this factor (the radius varies as 1/w, monotonic along a row, plus the Jacobian's
 // change, a few percent for voxels far from the camera).
@@ -140,35 +143,39 @@ void quadrantDistance(const Mat& label, const Rect& roi, int sx, int sy, Mat& di
     CV_CheckTypeEQ(label.type(), CV_8UC1, "label image");
     CV_Assert(dist.type() == CV_8SC1 && dist.size() == label.size());
     CV_Assert((roi & Rect(Point(0, 0), label.size())) == roi);
-    const int kSat = 127;
-    const int xs = sx > 0 ? roi.x + roi.width - 1 : roi.x, xe = sx > 0 ? roi.x - 1 : roi.x + roi.width;
-    const int ys = sy > 0 ? roi.y + roi.height - 1 : roi.y, ye = sy > 0 ? roi.y - 1 : roi.y + roi.height;
-    const int dx = -sx, dy = -sy;  // raster order: from the far corner back
-    for (int y = ys; y != ye; y += dy)
+    if (roi.empty())
+        return;
+    const uchar kSat = 127;
+    const int w = roi.width;
+    const int xs = sx > 0 ? roi.x + roi.width - 1 : roi.x;
+    const int ys = sy > 0 ? roi.y + roi.height - 1 : roi.y;
+    // Two one-label distances, to the nearest outside pixel (dk) and to the nearest kept pixel
+    // (dout), in processing order t (t = 0 at the far corner's column), with a sentinel at t = -1
+    // and a sentinel row before the first: no source beyond the roi.
+    std::vector<uchar> buf(4 * (w + 1), kSat);
+    uchar* pk = &buf[0] + 1;
+    uchar* po = &buf[w + 1] + 1;
+    uchar* ck = &buf[2 * (w + 1)] + 1;
+    uchar* co = &buf[3 * (w + 1)] + 1;
+    for (int r = 0; r < roi.height; r++)
     {
-        const uchar* l = label.ptr<uchar>(y);
-        schar* d = dist.ptr<schar>(y);
-        const bool hasPrev = y != ys;
-        const uchar* lp = hasPrev ? label.ptr<uchar>(y + sy) : nullptr;
-        const schar* dp = hasPrev ? dist.ptr<schar>(y + sy) : nullptr;
-        for (int x = xs; x != xe; x += dx)
+        const int y = ys - sy * r;
+        const uchar* l = label.ptr<uchar>(y) + xs;
+        schar* d = dist.ptr<schar>(y) + xs;
+        const int step = -sx;
+        for (int t = 0; t < w; t++)
         {
-            const bool a = l[x] != 0;
-            int best = kSat;
-            const bool hasNext = x != xs;
-            // Neighbours (x + sx, y), (x, y + sy), (x + sx, y + sy): already done.
-            if (hasNext)
-                best = std::min(best, (l[x + sx] != 0) != a ? 1 : std::abs((int)d[x + sx]) + 1);
-            if (hasPrev)
-            {
-                best = std::min(best, (lp[x] != 0) != a ? 1 : std::abs((int)dp[x]) + 1);
-                if (hasNext)
-                    best = std::min(best, (lp[x + sx] != 0) != a ? 1
-                                                             : std::abs((int)dp[x + sx]) + 1);
-            }
-            best = std::min(best, kSat);
-            d[x] = (schar)(a ? best : -best);
+            const bool kept = l[step * t] != 0;
+            const int mk = std::min(std::min((int)ck[t - 1], (int)pk[t]), (int)pk[t - 1]) + 1;
+            const int mo = std::min(std::min((int)co[t - 1], (int)po[t]), (int)po[t - 1]) + 1;
+            const uchar vk = kept ? (uchar)std::min(mk, (int)kSat) : (uchar)0;
+            const uchar vo = kept ? (uchar)0 : (uchar)std::min(mo, (int)kSat);
+            ck[t] = vk;
+            co[t] = vo;
+            d[step * t] = kept ? (schar)vk : (schar)(-(int)vo);
         }
+        std::swap(pk, ck);
+        std::swap(po, co);
     }
 }
 
@@ -241,6 +248,10 @@ CarveView VoxelGrid::carveView(const Camera& camera, const Mat& keep) const
                 int sq = 0;
                 if (dq && qx >= v.roi.x && qx < v.roi.x + v.roi.width)
                     sq = std::max((int)dq[qx], 0);
+                w[2 * x] = (uchar)(schar)sq;
+                w[2 * x + 1] = 0;
+                if (sq > 2 * v.rad)
+                    continue;  // the walk skips here; no exact test needs the neighbours
                 // Neighbours off the padded image are unknown (kept).
                 auto out = [&](const uchar* r, int xx) {
                     return r && xx >= 0 && xx < W && !r[xx];
@@ -248,7 +259,6 @@ CarveView VoxelGrid::carveView(const Camera& camera, const Mat& keep) const
                 const int nb = out(ku, x - 1) | out(ku, x) << 1 | out(ku, x + 1) << 2 |
                                out(k, x - 1) << 3 | out(k, x + 1) << 4 |
                                out(kd, x - 1) << 5 | out(kd, x) << 6 | out(kd, x + 1) << 7;
-                w[2 * x] = (uchar)(schar)sq;
                 w[2 * x + 1] = (uchar)nb;
             }
         }
@@ -480,6 +490,153 @@ void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* ro
     }
 }
 
+// Affine (quadrant) views: the row walk with everything that does not depend on the row
+// precomputed, and the skip lengths as integer tables of the map value. Same rules as carveRow's
+// quadrant branch.
+class AffineWalk
+{
+public:
+    AffineWalk(const CarveView& view) : view_(view)
+    {
+        const VoxelProjector& P = view.proj;
+        B0_ = P.M(0, 0);
+        B1_ = P.M(1, 0);
+        const double inv = 1.0 / std::max(std::max(std::abs(B0_), std::abs(B1_)), 1e-9);
+        rad_ = view.rad;
+        pad_ = view.pad;
+        W_ = view.keep.cols;
+        H_ = view.keep.rows;
+        rx0_ = view.roi.x;
+        ry0_ = view.roi.y;
+        rw_ = (unsigned)view.roi.width;
+        rh_ = (unsigned)view.roi.height;
+        walk_ = view.walk.ptr<uchar>();
+        wstep_ = view.walk.step[0];
+        inv_ = inv;
+        for (int d = 0; d < 128; d++)
+        {
+            // Outside: the next n voxels are outside too; kept (d > 2 rad): the next n are kept.
+            skipOut_[d] = 1 + std::max((int)std::floor((d - 1 - kSkipEps) * inv), 0);
+            skipIn_[d] = 1 + std::max((int)std::floor((d - 1 - 2 * rad_ - kSkipEps) * inv), 0);
+        }
+    }
+
+    //! One row's walk: voxels [i, end) of `row` are left.
+    struct State
+    {
+        uchar* row;
+        int j, k, i, end;
+        double A0, A1;
+    };
+
+    void begin(State& st, int j, int k, uchar* row, int lo, int hi) const
+    {
+        const VoxelProjector& P = view_.proj;
+        st.row = row;
+        st.j = j;
+        st.k = k;
+        st.i = lo;
+        st.end = hi + 1;
+        st.A0 = P.M(0, 1) * j + P.M(0, 2) * k + P.c[0];
+        st.A1 = P.M(1, 1) * j + P.M(1, 2) * k + P.c[1];
+    }
+
+    //! Advances the walk by one decision; false when the row is done.
+    inline bool step(State& st) const
+    {
+        uchar* row = st.row;
+        const int j = st.j, k = st.k, end = st.end;
+        const double A0 = st.A0, A1 = st.A1;
+        int i = st.i;
+        do  // one decision; `continue` ends it
+        {
+            if (i >= end)
+                break;
+            if (!row[i])
+            {
+                const void* nxt = std::memchr(row + i, 1, (size_t)(end - i));
+                i = nxt ? (int)((const uchar*)nxt - row) : end;
+                continue;
+            }
+            const int px = cvRound(A0 + B0_ * i) + pad_, py = cvRound(A1 + B1_ * i) + pad_;
+            if ((unsigned)(px - rx0_) >= rw_ || (unsigned)(py - ry0_) >= rh_)
+            {
+                if (px < 0 || py < 0 || px >= W_ || py >= H_)
+                {
+                    // Off the padded image: unknown, kept (as carveRow).
+                    const int dOut = std::max(std::max(-px, px - (W_ - 1)),
+                                              std::max(-py, py - (H_ - 1)));
+                    const int n = (int)std::floor((dOut + pad_ - 1 - rad_ - kSkipEps) * inv_);
+                    i += std::max(n, 0) + 1;
+                }
+                else
+                {
+                    // Not reached (footprints lie in the roi), but stay exact if it were.
+                    if (!footprintKeptFast(view_, i, j, k))
+                        row[i] = 0;
+                    i++;
+                }
+                continue;
+            }
+            const uchar* wp = walk_ + (size_t)py * wstep_ + 2 * px;
+            const int sv = (schar)wp[0];
+            if (sv < 0)
+            {
+                const int e = std::min(end, i + skipOut_[-sv]);
+                if (e - i <= 8)
+                    for (; i < e; i++)
+                        row[i] = 0;
+                else
+                {
+                    std::memset(row + i, 0, (size_t)(e - i));
+                    i = e;
+                }
+                continue;
+            }
+            if (sv > 2 * rad_)
+            {
+                i += skipIn_[sv];
+                continue;
+            }
+            if (!exactKept(wp, px, py, i, j, k))
+                row[i] = 0;
+            i++;
+        } while (false);
+        st.i = i;
+        return i < end;
+    }
+
+private:
+    inline bool exactKept(const uchar* wp, int px, int py, int i, int j, int k) const
+    {
+        int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+        double z = 0;
+        view_.proj.footprint(i, j, k, x0, x1, y0, y1, z);
+        x0 -= px - pad_;
+        x1 -= px - pad_;
+        y0 -= py - pad_;
+        y1 -= py - pad_;
+        if (x0 >= -1 && x1 <= 1 && y0 >= -1 && y1 <= 1)
+        {
+            int m9 = 0;
+            for (int yy = y0; yy <= y1; yy++)
+                for (int xx = x0; xx <= x1; xx++)
+                    m9 |= 1 << ((yy + 1) * 3 + xx + 1);
+            const int m8 = (m9 & 15) | ((m9 >> 5) << 4);
+            return (wp[1] & m8) == 0;  // the centre is kept (sv >= 0)
+        }
+        return footprintKeptFast(view_, i, j, k);
+    }
+
+    const CarveView& view_;
+    double B0_, B1_, inv_;
+    int rad_, pad_, W_, H_, rx0_, ry0_;
+    unsigned rw_, rh_;
+    const uchar* walk_;
+    size_t wstep_;
+    int skipOut_[128], skipIn_[128];
+};
+
 // Last alive voxel of row[lo..hi], or lo - 1 when none.
 inline int lastAlive(const uchar* row, int lo, int hi)
 {
@@ -520,6 +677,10 @@ void VoxelGrid::carve(const std::vector<CarveView>& views)
     // Per z slice, view by view (the view's maps stay in cache over the slice), each row only over
     // its alive span; a row that dies needs no further view. Rows are independent, so the result
     // does not depend on the partition into threads.
+    std::vector<std::unique_ptr<AffineWalk> > affine(views.size());
+    for (size_t q = 0; q < views.size(); q++)
+        if (views[q].quadrant)
+            affine[q].reset(new AffineWalk(views[q]));
     parallel_for_(Range(0, dims[2]), [&](const Range& r) {
         std::vector<int> lo(ny), hi(ny);
         for (int k = r.start; k < r.end; k++)
@@ -534,23 +695,50 @@ void VoxelGrid::carve(const std::vector<CarveView>& views)
             for (const auto& s : strength)
             {
                 const CarveView& view = views[s.second];
+                const AffineWalk* aw = affine[s.second].get();
                 bool any = false;
+                auto update = [&](int jj) {
+                    const uchar* rr = &data[index(0, jj, k)];
+                    const void* f = std::memchr(rr + lo[jj], 1, (size_t)(hi[jj] - lo[jj] + 1));
+                    if (!f)
+                    {
+                        lo[jj] = nx;
+                        hi[jj] = -1;
+                        return;
+                    }
+                    lo[jj] = (int)((const uchar*)f - rr);
+                    hi[jj] = lastAlive(rr, lo[jj], hi[jj]);
+                    any = true;
+                };
                 for (int j = 0; j < ny; j++)
                 {
                     if (lo[j] > hi[j])
                         continue;
-                    uchar* row = &data[index(0, j, k)];
-                    carveRow(*this, view, j, k, row, lo[j], hi[j]);
-                    const void* f = std::memchr(row + lo[j], 1, (size_t)(hi[j] - lo[j] + 1));
-                    if (!f)
+                    if (!aw)
                     {
-                        lo[j] = nx;
-                        hi[j] = -1;
+                        carveRow(*this, view, j, k, &data[index(0, j, k)], lo[j], hi[j]);
+                        update(j);
                         continue;
                     }
-                    lo[j] = (int)((const uchar*)f - row);
-                    hi[j] = lastAlive(row, lo[j], hi[j]);
-                    any = true;
+                    // Several rows walked in lockstep: their cache misses overlap.
+                    AffineWalk::State st[kLanes];
+                    int rows[kLanes], n = 0;
+                    for (int jj = j; jj < ny && n < kLanes; jj++)
+                        if (lo[jj] <= hi[jj])
+                        {
+                            aw->begin(st[n], jj, k, &data[index(0, jj, k)], lo[jj], hi[jj]);
+                            rows[n++] = jj;
+                        }
+                    bool more = true;
+                    while (more)
+                    {
+                        more = false;
+                        for (int l = 0; l < n; l++)
+                            more |= aw->step(st[l]);
+                    }
+                    for (int l = 0; l < n; l++)
+                        update(rows[l]);
+                    j = rows[n - 1];
                 }
                 if (!any)
                     break;
