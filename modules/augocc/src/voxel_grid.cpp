@@ -905,6 +905,37 @@ void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* f
             if (proj.viewDir[a] < 0) frontMask |= (uchar)(1 << (2 * a + 1));
         }
     const bool cull = frontOnly && faces;
+    if (proj.affine && !zmax)
+    {
+        // The renderer's path: VoxelProjector::footprint's arithmetic term for term (so key
+        // frames stay exact), without its general branches.
+        const double ru = proj.ruAffine, rv = proj.rvAffine;
+        const double m00 = proj.M(0, 0), m01 = proj.M(0, 1), m02 = proj.M(0, 2);
+        const double m10 = proj.M(1, 0), m11 = proj.M(1, 1), m12 = proj.M(1, 2);
+        const double c0 = proj.c[0], c1 = proj.c[1];
+        for (size_t q = 0; q < n; q++)
+        {
+            if (cull && !(faces[q] & frontMask))
+                continue;
+            int i, j, k;
+            unpackVoxel(ijk[q], i, j, k);
+            const double u = m00 * i + m01 * j + m02 * k + c0;
+            const double v = m10 * i + m11 * j + m12 * k + c1;
+            const int pu = cvRound(u), pv = cvRound(v);
+            const int x0 = std::max(std::min(cvCeil(u - ru), pu), X0);
+            const int x1 = std::min(std::max(cvFloor(u + ru), pu), X1);
+            const int y0 = std::max(std::min(cvCeil(v - rv), pv), Y0);
+            const int y1 = std::min(std::max(cvFloor(v + rv), pv), Y1);
+            const float z = (float)(proj.Z[0] * i + proj.Z[1] * j + proj.Z[2] * k + proj.z0);
+            for (int y = y0; y <= y1; y++)
+            {
+                float* zr = zmin.ptr<float>(y - offset.y) - offset.x;
+                for (int x = x0; x <= x1; x++)
+                    zr[x] = std::min(zr[x], z);
+            }
+        }
+        return;
+    }
     for (size_t q = 0; q < n; q++)
     {
         int i, j, k;
@@ -990,7 +1021,9 @@ void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
     parallel_for_(Range(0, chunks), [&](const Range& r) {
         for (int c = r.start; c < r.end; c++)
         {
-            Mat b(roi.size(), CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+            // Chunk 0 splats straight into the output (already +inf), the others into buffers.
+            Mat b = c == 0 ? zmin(roi)
+                           : Mat(roi.size(), CV_32F, Scalar(std::numeric_limits<float>::infinity()));
             for (const VoxelList& l : lists)
             {
                 const size_t a = l.n * c / chunks, e = l.n * (c + 1) / chunks;
@@ -1001,7 +1034,6 @@ void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
         }
     });
     Mat dst = zmin(roi);
-    bufs[0].copyTo(dst);
     for (int c = 1; c < chunks; c++)
         cv::min(dst, bufs[c], dst);
 }

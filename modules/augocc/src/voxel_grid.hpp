@@ -90,10 +90,10 @@ struct VoxelProjector
                              std::abs(M(1, 2) - v * M(2, 2)));
         }
         const int pu = cvRound(u), pv = cvRound(v);
-        x0 = std::min((int)std::ceil(u - ru), pu);
-        x1 = std::max((int)std::floor(u + ru), pu);
-        y0 = std::min((int)std::ceil(v - rv), pv);
-        y1 = std::max((int)std::floor(v + rv), pv);
+        x0 = std::min(cvCeil(u - ru), pu);
+        x1 = std::max(cvFloor(u + ru), pu);
+        y0 = std::min(cvCeil(v - rv), pv);
+        y1 = std::max(cvFloor(v + rv), pv);
         depth = Z[0] * i + Z[1] * j + Z[2] * k + z0;
         return true;
     }
