@@ -908,25 +908,32 @@ void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* f
     if (proj.affine && !zmax)
     {
         // The renderer's path: VoxelProjector::footprint's arithmetic term for term (so key
-        // frames stay exact), without its general branches.
+        // frames stay exact), with the row part computed once per voxel row (voxels come sorted).
         const double ru = proj.ruAffine, rv = proj.rvAffine;
-        const double m00 = proj.M(0, 0), m01 = proj.M(0, 1), m02 = proj.M(0, 2);
-        const double m10 = proj.M(1, 0), m11 = proj.M(1, 1), m12 = proj.M(1, 2);
-        const double c0 = proj.c[0], c1 = proj.c[1];
+        const Matx33d& M = proj.M;
+        uint32_t lastRow = ~0u;
+        double a0 = 0, a1 = 0, az = 0;
         for (size_t q = 0; q < n; q++)
         {
             if (cull && !(faces[q] & frontMask))
                 continue;
-            int i, j, k;
-            unpackVoxel(ijk[q], i, j, k);
-            const double u = m00 * i + m01 * j + m02 * k + c0;
-            const double v = m10 * i + m11 * j + m12 * k + c1;
+            const uint32_t p = ijk[q];
+            const int i = (int)(p & 1023u);
+            if ((p >> 10) != lastRow)
+            {
+                lastRow = p >> 10;
+                const int j = (int)(lastRow & 1023u), k = (int)(lastRow >> 10);
+                a0 = M(0, 1) * j + M(0, 2) * k + proj.c[0];
+                a1 = M(1, 1) * j + M(1, 2) * k + proj.c[1];
+                az = proj.Z[1] * j + proj.Z[2] * k + proj.z0;
+            }
+            const double u = M(0, 0) * i + a0, v = M(1, 0) * i + a1;
             const int pu = cvRound(u), pv = cvRound(v);
             const int x0 = std::max(std::min(cvCeil(u - ru), pu), X0);
             const int x1 = std::min(std::max(cvFloor(u + ru), pu), X1);
             const int y0 = std::max(std::min(cvCeil(v - rv), pv), Y0);
             const int y1 = std::min(std::max(cvFloor(v + rv), pv), Y1);
-            const float z = (float)(proj.Z[0] * i + proj.Z[1] * j + proj.Z[2] * k + proj.z0);
+            const float z = (float)(proj.Z[0] * i + az);
             for (int y = y0; y <= y1; y++)
             {
                 float* zr = zmin.ptr<float>(y - offset.y) - offset.x;

@@ -66,8 +66,10 @@ struct VoxelProjector
     inline bool footprint(double i, double j, double k, int& x0, int& x1, int& y0, int& y1,
                           double& depth) const
     {
-        const double hx = M(0, 0) * i + M(0, 1) * j + M(0, 2) * k + c[0];
-        const double hy = M(1, 0) * i + M(1, 1) * j + M(1, 2) * k + c[1];
+        // Row part first (M(:,1) j + M(:,2) k + c, then + M(:,0) i): the row walk and the
+        // renderer evaluate it once per voxel row and get the same bits.
+        const double hx = M(0, 0) * i + (M(0, 1) * j + M(0, 2) * k + c[0]);
+        const double hy = M(1, 0) * i + (M(1, 1) * j + M(1, 2) * k + c[1]);
         double u, v, ru, rv;
         if (affine)
         {
@@ -94,7 +96,7 @@ struct VoxelProjector
         x1 = std::max(cvFloor(u + ru), pu);
         y0 = std::min(cvCeil(v - rv), pv);
         y1 = std::max(cvFloor(v + rv), pv);
-        depth = Z[0] * i + Z[1] * j + Z[2] * k + z0;
+        depth = Z[0] * i + (Z[1] * j + Z[2] * k + z0);
         return true;
     }
 };
