@@ -18,7 +18,7 @@ namespace {
 // label change (distances are integers; steps are in pixels).
 const double kSkipEps = 1e-6;
 // Affine views: rows walked in lockstep by one thread (independent walks overlap cache misses).
-const int kLanes = 4;
+const int kLanes = 8;
 // Perspective rows: the footprint radius changes along a row; its bound from the two ends is
 // widened by this factor (the radius varies as 1/w, monotonic along a row, plus the Jacobian's
 // change, a few percent for voxels far from the camera).
