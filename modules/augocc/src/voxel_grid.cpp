@@ -609,6 +609,10 @@ public:
 private:
     inline bool exactKept(const uchar* wp, int px, int py, int i, int j, int k) const
     {
+        // px, py are the footprint's own rounded centre (same arithmetic), and footprints lie
+        // within rad of it: with no outside neighbour there is nothing to test.
+        if (rad_ <= 1 && wp[1] == 0)
+            return true;
         int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
         double z = 0;
         view_.proj.footprint(i, j, k, x0, x1, y0, y1, z);
