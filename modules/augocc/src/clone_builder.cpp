@@ -92,61 +92,80 @@ void checkMask(const Mat& m, const Reconstruction& rec, const String& object, in
 // ---------------------------------------------------------------------------------------------
 // Step 1: clustering
 
+// Silhouette evidence of point X for `object`: -1 when a key frame where it is seen puts it outside
+// every silhouette of this object and of the others (it cannot be the object's), else the number
+// of key frames whose silhouette of this object holds it.
+int silhouetteVotes(const Reconstruction& rec, const ObjectMasks& all, const String& object,
+                    const Tracks* tracks, int p, const Vec3d& X)
+{
+    const FrameMasks& masks = all.at(object);
+    const Rect img(Point(0, 0), rec.imageSize);
+    int inCount = 0;
+    for (const auto& fm : masks)
+    {
+        const int f = fm.first;
+        if (tracks && (f >= tracks->frames() || !tracks->observed(f, p)))
+            continue;
+        const Point2d uv = rec.project(f, X);
+        const Point px(cvRound(uv.x), cvRound(uv.y));
+        if (!img.contains(px))
+        {
+            if (tracks)
+                return -1;  // seen in the frame but projects off it: inconsistent point
+            continue;
+        }
+        if (fm.second.at<uchar>(px) > 127)
+        {
+            inCount++;
+            continue;
+        }
+        // Under another object's silhouette the point may be hidden there: no evidence.
+        bool hidden = false;
+        for (const auto& other : all)
+        {
+            if (other.first == object)
+                continue;
+            auto it = other.second.find(f);
+            if (it != other.second.end() && it->second.at<uchar>(px) > 127)
+            {
+                hidden = true;
+                break;
+            }
+        }
+        if (!hidden)
+            return -1;
+    }
+    return inCount;
+}
+
+// Step 1: the points of `object`: consistent with its silhouettes (silhouetteVotes >= 1) and, when
+// they are consistent with other objects too (a point behind one object and seen inside another's
+// silhouette), held by this object's silhouettes in at least as many key frames as by any other's.
 std::vector<Vec3d> clusterPoints(const Reconstruction& rec, const ObjectMasks& all,
                                  const String& object, const Tracks* tracks)
 {
     std::vector<Vec3d> out;
     if (rec.points.empty())
         return out;
-    const FrameMasks& masks = all.at(object);
     const int P = rec.points.rows;
-    const Rect img(Point(0, 0), rec.imageSize);
     for (int p = 0; p < P; p++)
     {
         const double* q = rec.points.ptr<double>(p);
         if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
             continue;
         const Vec3d X(q[0], q[1], q[2]);
-        int inCount = 0;
-        bool ok = true;
-        for (const auto& fm : masks)
-        {
-            const int f = fm.first;
-            if (tracks && (f >= tracks->frames() || !tracks->observed(f, p)))
-                continue;
-            const Point2d uv = rec.project(f, X);
-            const Point px(cvRound(uv.x), cvRound(uv.y));
-            if (!img.contains(px))
+        const int mine = silhouetteVotes(rec, all, object, tracks, p, X);
+        if (mine <= 0)
+            continue;
+        bool best = true;
+        for (const auto& other : all)
+            if (other.first != object &&
+                silhouetteVotes(rec, all, other.first, tracks, p, X) > mine)
             {
-                if (tracks)
-                    ok = false;  // seen in the frame but projects off it: inconsistent point
-                continue;
-            }
-            if (fm.second.at<uchar>(px) > 127)
-            {
-                inCount++;
-                continue;
-            }
-            // Under another object's silhouette the point may be hidden there: no evidence.
-            bool hidden = false;
-            for (const auto& other : all)
-            {
-                if (other.first == object)
-                    continue;
-                auto it = other.second.find(f);
-                if (it != other.second.end() && it->second.at<uchar>(px) > 127)
-                {
-                    hidden = true;
-                    break;
-                }
-            }
-            if (!hidden)
-            {
-                ok = false;
+                best = false;
                 break;
             }
-        }
-        if (ok && inCount > 0)
+        if (best)
             out.push_back(X);
     }
     return out;
