@@ -660,6 +660,88 @@ Mat unknownMask(const std::map<String, ObjectClone>& objs, const String& object,
     return unknown;
 }
 
+// Beyond Step 4, for objects hidden in part: voxels that no key frame shows as the object (their
+// centre's pixel is never in its silhouette: unknown under nearer objects, or off the image, in
+// every key frame) and that are not connected (6-neighbours) to any voxel a key frame does show
+// are pure conjecture: a piece of the box hidden in every key frame. They go. Voxels connected to
+// seen ones stay (the hidden part of a visible object). Returns the number removed.
+int64 dropUnseenComponents(ObjectClone& obj, const Reconstruction& rec)
+{
+    VoxelGrid& g = obj.grid;
+    const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+    std::vector<VoxelProjector> projs;
+    std::vector<const Mat*> masks;
+    for (const auto& fm : obj.masks)
+    {
+        projs.push_back(g.projector(rec.camera(fm.first), fm.second.size()));
+        masks.push_back(&fm.second);
+    }
+    // Seeds: voxels some key frame shows (marked 2).
+    const uchar kSeen = 2;
+    parallel_for_(Range(0, nz), [&](const Range& r) {
+        for (int k = r.start; k < r.end; k++)
+            for (int j = 0; j < ny; j++)
+            {
+                uchar* row = &g.data[g.index(0, j, k)];
+                for (int i = 0; i < nx; i++)
+                {
+                    if (!row[i])
+                        continue;
+                    for (size_t q = 0; q < projs.size(); q++)
+                    {
+                        int x0, x1, y0, y1;
+                        double z;
+                        if (!projs[q].footprint(i, j, k, x0, x1, y0, y1, z))
+                            continue;
+                        const double u = projs[q].M(0, 0) * i + (projs[q].M(0, 1) * j +
+                                         projs[q].M(0, 2) * k + projs[q].c[0]);
+                        const double v = projs[q].M(1, 0) * i + (projs[q].M(1, 1) * j +
+                                         projs[q].M(1, 2) * k + projs[q].c[1]);
+                        const double w = projs[q].affine ? 1.0
+                                         : projs[q].M(2, 0) * i + (projs[q].M(2, 1) * j +
+                                           projs[q].M(2, 2) * k + projs[q].c[2]);
+                        const Point px(cvRound(u / w), cvRound(v / w));
+                        if (px.x >= 0 && px.y >= 0 && px.x < masks[q]->cols &&
+                            px.y < masks[q]->rows && masks[q]->at<uchar>(px) > 127)
+                        {
+                            row[i] = kSeen;
+                            break;
+                        }
+                    }
+                }
+            }
+    });
+    // Flood from the seen voxels through alive ones (sequential: the result is a set, the same
+    // whatever the order).
+    std::vector<size_t> stack;
+    for (size_t n = 0; n < g.data.size(); n++)
+        if (g.data[n] == kSeen)
+            stack.push_back(n);
+    const size_t sy = (size_t)nx, sz = (size_t)nx * ny;
+    while (!stack.empty())
+    {
+        const size_t n = stack.back();
+        stack.pop_back();
+        const int i = (int)(n % sy), j = (int)((n / sy) % ny), k = (int)(n / sz);
+        const size_t nb[6] = {i > 0 ? n - 1 : n, i + 1 < nx ? n + 1 : n, j > 0 ? n - sy : n,
+                              j + 1 < ny ? n + sy : n, k > 0 ? n - sz : n,
+                              k + 1 < nz ? n + sz : n};
+        for (size_t m : nb)
+            if (g.data[m] == 1)
+            {
+                g.data[m] = kSeen;
+                stack.push_back(m);
+            }
+    }
+    int64 dropped = 0;
+    for (uchar& v : g.data)
+    {
+        dropped += v == 1;
+        v = v == kSeen ? 1 : 0;
+    }
+    return dropped;
+}
+
 void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
                    const Reconstruction& rec, const std::vector<int>& carveFrames,
                    bool occlusionAware, int raysPerPixel)
@@ -677,6 +759,15 @@ void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
         }
     });
     obj.grid.carve(views);
+    if (occlusionAware)
+    {
+        const int64 d = dropUnseenComponents(obj, rec);
+        if (d > 0)
+        {
+            CV_LOG_DEBUG(NULL, cv::format("augocc: object '%s': %lld voxels no key frame shows, "
+                         "apart from the seen ones, removed", obj.name.c_str(), (long long)d));
+        }
+    }
     obj.surface = obj.grid.surface();
     // Step 5 for every key frame (the clone changed, so every patch set is redone).
     std::vector<int> keys;
