@@ -717,6 +717,14 @@ int64 dropUnseenComponents(ObjectClone& obj, const Reconstruction& rec)
     for (size_t n = 0; n < g.data.size(); n++)
         if (g.data[n] == kSeen)
             stack.push_back(n);
+    if (stack.empty())
+    {
+        // Nothing seen at all (silhouettes thinner than the voxel spacing): no evidence either
+        // way, keep the clone as carved.
+        for (uchar& v : g.data)
+            v = v ? 1 : 0;
+        return 0;
+    }
     const size_t sy = (size_t)nx, sz = (size_t)nx * ny;
     while (!stack.empty())
     {
