@@ -325,7 +325,8 @@ inline bool footprintKeptFast(const CarveView& view, int i, int j, int k)
     return true;
 }
 
-// Carves voxels lo..hi of one voxel row (j, k) with one view. Walks the alive voxels, and uses the
+// Carves voxels lo..hi of one voxel row (j, k) with one view (perspective views; affine views
+// use AffineWalk). Walks the alive voxels, and uses the symmetric
 // chessboard distance of the pixel under the current voxel to skip every following voxel that
 // provably has the same outcome: moving the projected centre by delta (L-inf) moves its rounded
 // pixel by at most floor(delta) + 1, and footprints lie within `rad` of that pixel.
@@ -375,10 +376,6 @@ void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* ro
     const int W = view.keep.cols, H = view.keep.rows;
     const schar* dist = view.dist.ptr<schar>();
     const size_t dstep = view.dist.step[0];
-    const int rx0 = view.roi.x, ry0 = view.roi.y;
-    const int rx1 = view.roi.x + view.roi.width, ry1 = view.roi.y + view.roi.height;
-    const uchar* walk = view.quadrant ? view.walk.ptr<uchar>() : nullptr;
-    const size_t wstep = view.quadrant ? view.walk.step[0] : 0;
     const int end = hi + 1;
     int i = lo;
     while (i < end)
@@ -406,62 +403,6 @@ void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* ro
             const int dOut = std::max(std::max(-px, px - (W - 1)), std::max(-py, py - (H - 1)));
             const int n = (int)((dOut + pad - 1 - rad - kSkipEps) * inv);
             i += std::max(n, 0) + 1;
-            continue;
-        }
-        if (view.quadrant)
-        {
-            // The rest of the row stays in the quadrant ahead of this pixel (rounding is
-            // monotonic). Outside: the next n voxels' pixels are within floor(n step) + 1 of it,
-            // all outside. Kept: their footprints lie in the quadrant ahead of q, this pixel moved
-            // back by rad, within floor(n step) + 1 + 2 rad of q.
-            if (px < rx0 || py < ry0 || px >= rx1 || py >= ry1)
-            {
-                // Not reached (footprints lie in the roi), but stay exact if it were.
-                if (!footprintKeptFast(view, i, j, k))
-                    row[i] = 0;
-                i++;
-                continue;
-            }
-            const int rad1 = view.rad;
-            const uchar* wp = walk + (size_t)py * wstep + 2 * px;
-            const int sv = (schar)wp[0];
-            if (sv < 0)
-            {
-                const int n = std::max((int)((-sv - 1 - kSkipEps) * inv), 0);
-                const int e = std::min(end, i + n + 1);
-                std::memset(row + i, 0, (size_t)(e - i));
-                i = e;
-                continue;
-            }
-            if (sv > 2 * rad1)
-            {
-                const int n = (int)((sv - 1 - 2 * rad1 - kSkipEps) * inv);
-                i += std::max(n, 0) + 1;
-                continue;
-            }
-            // Exact test; from the neighbour mask when the footprint is within one pixel.
-            int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
-            double z = 0;
-            view.proj.footprint(i, j, k, x0, x1, y0, y1, z);
-            x0 -= px - pad;
-            x1 -= px - pad;
-            y0 -= py - pad;
-            y1 -= py - pad;
-            bool kept;
-            if (x0 >= -1 && x1 <= 1 && y0 >= -1 && y1 <= 1)
-            {
-                int m9 = 0;
-                for (int yy = y0; yy <= y1; yy++)
-                    for (int xx = x0; xx <= x1; xx++)
-                        m9 |= 1 << ((yy + 1) * 3 + xx + 1);
-                const int m8 = (m9 & 15) | ((m9 >> 5) << 4);
-                kept = (wp[1] & m8) == 0;  // the centre is kept (sv >= 0)
-            }
-            else
-                kept = footprintKeptFast(view, i, j, k);
-            if (!kept)
-                row[i] = 0;
-            i++;
             continue;
         }
         // One signed byte per pixel: +D in the keep region, -D outside (see CarveView).
