@@ -283,11 +283,19 @@ public:
         if (roi.area() > 0)
         {
             const int winY = rsz.height - roi.y - roi.height;
-            glEnable(GL_SCISSOR_TEST);
-            glScissor(roi.x, winY, roi.width, roi.height);
+            // A clear of the whole buffer (colour, depth and stencil together) is a fast clear in
+            // llvmpipe; a scissored one draws a quad through the fragment shader. Only the ROI is
+            // read, so either is right: the fast one while the ROI is a good part of the buffer.
             glClearColor(0, 0, 0, 0);
             glClearDepth(1.0);
-            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            glClearStencil(0);
+            const bool wholeClear = 4 * (double)roi.area() >= (double)rsz.area();
+            if (wholeClear)
+                glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(roi.x, winY, roi.width, roi.height);
+            if (!wholeClear)
+                glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
             glDisable(GL_LIGHTING);
             glDisable(GL_BLEND);
             glDisable(GL_DITHER);
