@@ -209,32 +209,42 @@ public:
         return Size(frameSize.width * params_.supersample, frameSize.height * params_.supersample);
     }
 
-    void composite(InputArray frame, int frameIndex, const Camera& camera, const CloneSet& clones,
-                   OutputArray result, OutputArray virtualLayer, OutputArray depth) CV_OVERRIDE
+    void composite(InputArray frameArr, int frameIndex, const Camera& camera,
+                   const CloneSet& clones, OutputArray result, OutputArray virtualLayer,
+                   OutputArray depthOut) CV_OVERRIDE
     {
-        const Size fsz = frame.size();
-        const Size rsz = renderSize(fsz);
-        const Camera rc = supersampledCamera(camera, params_.supersample);
-        Mat occ(rsz, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
-        Mat matte, d;
-        for (const String& name : clones.objectNames())
+        const Mat frame = checkedFrame(frameArr, camera);
+        const Size rsz = renderSize(frame.size());
+        const FramePlan pl = plan(camera, rsz);
+        // The clones are rendered only where the occluder depth is used: the ROI of the virtual
+        // objects, with the camera shifted by the ROI's corner (an integer shift of the
+        // principal point: the same pixels), or the whole render grid for the depth output.
+        const bool needZ = depthOut.needed();
+        const Rect area = needZ ? Rect(Point(), rsz) : pl.roi;
+        Mat occ;
+        if (area.area() > 0)
         {
-            clones.render(name, frameIndex, rc, rsz, matte, d);
-            CV_CheckTypeEQ(d.type(), CV_32FC1, "clone depth must be CV_32F");
-            CV_CheckEQ(d.size(), rsz, "clone depth size");
-            cv::min(occ, d, occ);
+            cloneOcc_.create(area.size(), CV_32F);
+            cloneOcc_.setTo(Scalar::all(std::numeric_limits<float>::infinity()));
+            const Camera ac = shiftedCamera(pl.rc, area.tl());
+            for (const String& name : clones.objectNames())
+            {
+                clones.render(name, frameIndex, ac, area.size(), noArray(), cloneDepth_);
+                CV_CheckTypeEQ(cloneDepth_.type(), CV_32FC1, "clone depth must be CV_32F");
+                CV_CheckEQ(cloneDepth_.size(), area.size(), "clone depth size");
+                cv::min(cloneOcc_, cloneDepth_, cloneOcc_);
+            }
+            occ = cloneOcc_;
         }
-        composite(frame, camera, occ, result, virtualLayer, depth);
+        const Mat occRoi = (needZ && pl.roi.area() > 0) ? occ(pl.roi) : occ;
+        compositeCore(frame, camera, pl, occRoi, needZ ? occ : Mat(), result, virtualLayer,
+                      depthOut);
     }
 
     void composite(InputArray frameArr, const Camera& camera, InputArray occluderArr,
                    OutputArray result, OutputArray virtualLayer, OutputArray depthOut) CV_OVERRIDE
     {
-        Mat frame = frameArr.getMat();
-        if (frame.empty())
-            CV_Error(Error::StsBadArg, "Compositor: empty frame");
-        CV_CheckTypeEQ(frame.type(), CV_8UC3, "Compositor: frame must be BGR CV_8UC3");
-        camera.validate("Compositor camera");
+        const Mat frame = checkedFrame(frameArr, camera);
         const int k = params_.supersample;
         const Size fsz = frame.size();
         const Size rsz = renderSize(fsz);
@@ -255,10 +265,34 @@ public:
                          "expected %dx%d or %dx%d", occ.cols, occ.rows, rsz.width, rsz.height,
                          fsz.width, fsz.height));
         }
+        const FramePlan pl = plan(camera, rsz);
+        const Mat occRoi = (occ.empty() || pl.roi.area() == 0) ? Mat() : occ(pl.roi);
+        compositeCore(frame, camera, pl, occRoi, occ, result, virtualLayer, depthOut);
+    }
 
-        ensureContext(rsz);
-        uploadIfDirty();
+private:
+    // What a frame needs before drawing: the depth range that holds the virtual objects, the
+    // camera of the render grid and the part of that grid where the virtual objects can appear.
+    struct FramePlan
+    {
+        double zNear = 0, zFar = 1;
+        Camera rc;
+        Rect roi;  // render grid, a multiple of k, so that it maps onto whole frame pixels
+    };
 
+    static Mat checkedFrame(InputArray frameArr, const Camera& camera)
+    {
+        Mat frame = frameArr.getMat();
+        if (frame.empty())
+            CV_Error(Error::StsBadArg, "Compositor: empty frame");
+        CV_CheckTypeEQ(frame.type(), CV_8UC3, "Compositor: frame must be BGR CV_8UC3");
+        camera.validate("Compositor camera");
+        return frame;
+    }
+
+    FramePlan plan(const Camera& camera, Size rsz) const
+    {
+        FramePlan pl;
         // Depth range that holds the virtual objects. Occluders nearer than the near plane clamp
         // to window depth 0 (they hide everything), farther than the far plane to 1 (nothing).
         double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
@@ -269,12 +303,43 @@ public:
                 zmin = std::min(zmin, z);
                 zmax = std::max(zmax, z);
             }
-        double zNear = 0, zFar = 1;
-        chooseDepthRange(camera, zmin, zmax, zNear, zFar);
-        const Camera rc = supersampledCamera(camera, k);
+        chooseDepthRange(camera, zmin, zmax, pl.zNear, pl.zFar);
+        pl.rc = supersampledCamera(camera, params_.supersample);
         // Only the part of the render grid where the virtual objects can appear is drawn, read
-        // back and blended (a multiple of k, so that it maps onto whole frame pixels).
-        const Rect roi = meshes_.empty() ? Rect() : screenRoi(rc, rsz, k, zNear);
+        // back and blended.
+        pl.roi = meshes_.empty() ? Rect() : screenRoi(pl.rc, rsz, params_.supersample, pl.zNear);
+        return pl;
+    }
+
+    // The camera of the sub-image whose top-left pixel is `corner` of the camera's image.
+    static Camera shiftedCamera(const Camera& camera, Point corner)
+    {
+        Camera c = camera;
+        if (camera.model == SCALED_ORTHOGRAPHIC)
+            c.pp = Point2d(camera.pp.x - corner.x, camera.pp.y - corner.y);
+        else
+        {
+            c.K(0, 2) = camera.K(0, 2) - corner.x;
+            c.K(1, 2) = camera.K(1, 2) - corner.y;
+            c.pp = Point2d(c.K(0, 2), c.K(1, 2));
+        }
+        return c;
+    }
+
+    // Draws, reads back, resolves against the occluder and blends. occRoi: occluder depth
+    // over pl.roi (empty: nothing occludes); occFull: over the render grid, for the depth
+    // output only (empty: nothing).
+    void compositeCore(const Mat& frame, const Camera& camera, const FramePlan& pl,
+                       const Mat& occRoi, const Mat& occFull, OutputArray result,
+                       OutputArray virtualLayer, OutputArray depthOut)
+    {
+        const int k = params_.supersample;
+        const Size fsz = frame.size();
+        const Size rsz = renderSize(fsz);
+        ensureContext(rsz);
+        uploadIfDirty();
+        const Rect& roi = pl.roi;
+        const double zNear = pl.zNear, zFar = pl.zFar;
 
         // layerRoi_: frame grid, ROI only: premultiplied RGB + alpha, CV_32FC4, top-down.
         // zRoi_: render grid, ROI only: camera z of the virtual surface (+inf: none).
@@ -300,7 +365,7 @@ public:
             glDisable(GL_BLEND);
             glDisable(GL_DITHER);
             glEnable(GL_DEPTH_TEST);
-            drawMeshes(rc, rsz, zNear, zFar);
+            drawMeshes(pl.rc, rsz, zNear, zFar);
             // glReadPixels waits for the rasteriser itself: no glFinish. RGBA bytes are the
             // buffer's own format (a plain copy in Mesa); the channel order is handled in
             // resolve().
@@ -313,17 +378,15 @@ public:
                          depthUp_.data);
             glDisable(GL_SCISSOR_TEST);
             frameRoi_ = frame(Rect(roi.x / k, roi.y / k, roi.width / k, roi.height / k));
-            resolve(camera, rgbaUp_, depthUp_, occ.empty() ? Mat() : occ(roi), zNear, zFar, k,
-                    needZ, layerRoi_, zRoi_);
+            resolve(camera, rgbaUp_, depthUp_, occRoi, zNear, zFar, k, needZ, layerRoi_, zRoi_);
         }
         const Rect froi(roi.x / k, roi.y / k, roi.width / k, roi.height / k);
         blend(frame, layerRoi_, froi, result, virtualLayer);
         frameRoi_ = Mat();
         if (needZ)
-            writeDepth(occ, zRoi_, roi, rsz, fsz, k, depthOut);
+            writeDepth(occFull, zRoi_, roi, rsz, fsz, k, depthOut);
     }
 
-private:
     void ensureContext(Size rsz)
     {
         if (!gl_)
@@ -874,6 +937,7 @@ private:
     std::vector<Vec3i> keptFaces_;  // frontFaces() of the mesh being drawn (reused)
     Mat frameRoi_;  // the frame under the ROI, guide of the refinement (during composite())
     Mat rgbaUp_, depthUp_, zRoi_, layerRoi_, visFrac_, allColor_;  // per-frame buffers, reused
+    Mat cloneOcc_, cloneDepth_;  // clone depth of composite(..., clones, ...), reused
 };
 
 } // namespace
