@@ -229,7 +229,8 @@ public:
             const Camera ac = shiftedCamera(pl.rc, area.tl());
             for (const String& name : clones.objectNames())
             {
-                clones.render(name, frameIndex, ac, area.size(), noArray(), cloneDepth_);
+                // The matte is not an optional output of CloneSet::render(): a reused buffer.
+                clones.render(name, frameIndex, ac, area.size(), cloneMatte_, cloneDepth_);
                 CV_CheckTypeEQ(cloneDepth_.type(), CV_32FC1, "clone depth must be CV_32F");
                 CV_CheckEQ(cloneDepth_.size(), area.size(), "clone depth size");
                 cv::min(cloneOcc_, cloneDepth_, cloneOcc_);
@@ -937,7 +938,7 @@ private:
     std::vector<Vec3i> keptFaces_;  // frontFaces() of the mesh being drawn (reused)
     Mat frameRoi_;  // the frame under the ROI, guide of the refinement (during composite())
     Mat rgbaUp_, depthUp_, zRoi_, layerRoi_, visFrac_, allColor_;  // per-frame buffers, reused
-    Mat cloneOcc_, cloneDepth_;  // clone depth of composite(..., clones, ...), reused
+    Mat cloneOcc_, cloneDepth_, cloneMatte_;  // composite(..., clones, ...), reused
 };
 
 } // namespace
