@@ -10,6 +10,7 @@
 #include "gl_context.hpp"
 #include "shading.hpp"
 
+#include <functional>
 #include <map>
 #include <tuple>
 #include <unordered_map>
@@ -216,16 +217,14 @@ public:
         const Mat frame = checkedFrame(frameArr, camera);
         const Size rsz = renderSize(frame.size());
         const FramePlan pl = plan(camera, rsz);
-        // The clones are rendered only where the occluder depth is used: the ROI of the virtual
-        // objects, with the camera shifted by the ROI's corner (an integer shift of the
-        // principal point: the same pixels), or the whole render grid for the depth output.
+        // The clones are rendered only where the occluder depth is used: the whole render grid
+        // for the depth output; else only the bounding box of the samples the virtual objects
+        // cover (known once they are drawn: tighter than the ROI, which bounds their 3D box),
+        // with the camera shifted by its corner (an integer shift of the principal point: the
+        // same pixels). The depth test reads the occluder at covered samples only.
         const bool needZ = depthOut.needed();
-        const Rect area = needZ ? Rect(Point(), rsz) : pl.roi;
-        Mat occ;
-        if (area.area() > 0)
-        {
-            cloneOcc_.create(area.size(), CV_32F);
-            cloneOcc_.setTo(Scalar::all(std::numeric_limits<float>::infinity()));
+        const float inf = std::numeric_limits<float>::infinity();
+        auto renderClones = [&](const Rect& area, Mat& occ) {
             const Camera ac = shiftedCamera(pl.rc, area.tl());
             for (const String& name : clones.objectNames())
             {
@@ -233,13 +232,30 @@ public:
                 clones.render(name, frameIndex, ac, area.size(), cloneMatte_, cloneDepth_);
                 CV_CheckTypeEQ(cloneDepth_.type(), CV_32FC1, "clone depth must be CV_32F");
                 CV_CheckEQ(cloneDepth_.size(), area.size(), "clone depth size");
-                cv::min(cloneOcc_, cloneDepth_, cloneOcc_);
+                cv::min(occ, cloneDepth_, occ);
             }
-            occ = cloneOcc_;
+        };
+        if (needZ)
+        {
+            cloneOcc_.create(rsz, CV_32F);
+            cloneOcc_.setTo(Scalar::all(inf));
+            renderClones(Rect(Point(), rsz), cloneOcc_);
+            const Mat occRoi = pl.roi.area() > 0 ? cloneOcc_(pl.roi) : Mat();
+            compositeCore(frame, camera, pl, [&](const Mat&) { return occRoi; }, cloneOcc_,
+                          result, virtualLayer, depthOut);
+            return;
         }
-        const Mat occRoi = (needZ && pl.roi.area() > 0) ? occ(pl.roi) : occ;
-        compositeCore(frame, camera, pl, occRoi, needZ ? occ : Mat(), result, virtualLayer,
-                      depthOut);
+        auto occluderOf = [&](const Mat& rgbaUp) {
+            const Rect cov = coveredRect(rgbaUp);
+            if (cov.area() == 0)
+                return Mat();
+            cloneOcc_.create(pl.roi.size(), CV_32F);
+            cloneOcc_.setTo(Scalar::all(inf));
+            Mat sub = cloneOcc_(cov);
+            renderClones(cov + pl.roi.tl(), sub);
+            return cloneOcc_;
+        };
+        compositeCore(frame, camera, pl, occluderOf, Mat(), result, virtualLayer, depthOut);
     }
 
     void composite(InputArray frameArr, const Camera& camera, InputArray occluderArr,
@@ -268,7 +284,8 @@ public:
         }
         const FramePlan pl = plan(camera, rsz);
         const Mat occRoi = (occ.empty() || pl.roi.area() == 0) ? Mat() : occ(pl.roi);
-        compositeCore(frame, camera, pl, occRoi, occ, result, virtualLayer, depthOut);
+        compositeCore(frame, camera, pl, [&](const Mat&) { return occRoi; }, occ, result,
+                      virtualLayer, depthOut);
     }
 
 private:
@@ -327,12 +344,24 @@ private:
         return c;
     }
 
-    // Draws, reads back, resolves against the occluder and blends. occRoi: occluder depth
-    // over pl.roi (empty: nothing occludes); occFull: over the render grid, for the depth
-    // output only (empty: nothing).
+    // Bounding box, top-down in the ROI, of the samples the virtual objects cover in the
+    // read-back colour (GL rows bottom-up).
+    static Rect coveredRect(const Mat& rgbaUp)
+    {
+        Mat alpha;
+        cv::extractChannel(rgbaUp, alpha, 3);
+        const Rect r = cv::boundingRect(alpha);  // non-zero pixels of a CV_8U image
+        if (r.area() == 0)
+            return Rect();
+        return Rect(r.x, rgbaUp.rows - r.y - r.height, r.width, r.height);
+    }
+
+    // Draws, reads back, resolves against the occluder and blends. occluderOf(rgbaUp): the
+    // occluder depth over pl.roi, right at least at the samples rgbaUp covers (empty: nothing
+    // occludes); occFull: over the render grid, for the depth output only (empty: nothing).
     void compositeCore(const Mat& frame, const Camera& camera, const FramePlan& pl,
-                       const Mat& occRoi, const Mat& occFull, OutputArray result,
-                       OutputArray virtualLayer, OutputArray depthOut)
+                       const std::function<Mat(const Mat&)>& occluderOf, const Mat& occFull,
+                       OutputArray result, OutputArray virtualLayer, OutputArray depthOut)
     {
         const int k = params_.supersample;
         const Size fsz = frame.size();
@@ -379,6 +408,7 @@ private:
                          depthUp_.data);
             glDisable(GL_SCISSOR_TEST);
             frameRoi_ = frame(Rect(roi.x / k, roi.y / k, roi.width / k, roi.height / k));
+            const Mat occRoi = occluderOf(rgbaUp_);
             resolve(camera, rgbaUp_, depthUp_, occRoi, zNear, zFar, k, needZ, layerRoi_, zRoi_);
         }
         const Rect froi(roi.x / k, roi.y / k, roi.width / k, roi.height / k);
