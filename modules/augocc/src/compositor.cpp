@@ -44,7 +44,8 @@ Camera supersampledCamera(const Camera& camera, int factor)
 }
 
 Compositor::Params::Params()
-    : supersample(3), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2), lightRotation(Matx33d::eye())
+    : supersample(3), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2),
+      lightRotation(Matx33d::eye())
 {
 }
 
@@ -586,7 +587,8 @@ private:
 
     Vec3d boundsCorner(int c) const
     {
-        return Vec3d((c & 1) ? boundsMax_[0] : boundsMin_[0], (c & 2) ? boundsMax_[1] : boundsMin_[1],
+        return Vec3d((c & 1) ? boundsMax_[0] : boundsMin_[0],
+                     (c & 2) ? boundsMax_[1] : boundsMin_[1],
                      (c & 4) ? boundsMax_[2] : boundsMin_[2]);
     }
 

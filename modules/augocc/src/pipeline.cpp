@@ -715,12 +715,14 @@ DemoResult runDemo(const DemoOptions& o)
     for (size_t i = 0; i < before.size(); i++)
     {
         sheet.push_back(before[i]);
-        captions.push_back(cv::format("frame %d: input", (int)(i * ((n - 1) / (kSheetFrames - 1)))));
+        captions.push_back(cv::format("frame %d: input",
+                                      (int)(i * ((n - 1) / (kSheetFrames - 1)))));
     }
     for (size_t i = 0; i < after.size(); i++)
     {
         sheet.push_back(after[i]);
-        captions.push_back(cv::format("frame %d: composite", (int)(i * ((n - 1) / (kSheetFrames - 1)))));
+        captions.push_back(cv::format("frame %d: composite",
+                                      (int)(i * ((n - 1) / (kSheetFrames - 1)))));
     }
     res.contactSheetPath = (dir / "contact_sheet.png").string();
     const Mat sheetImg = makeContactSheet(sheet, captions, (int)before.size(), 320);
