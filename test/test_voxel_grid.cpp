@@ -47,32 +47,40 @@ TEST_P(Augocc_VoxelGrid_P, carve_equals_brute_force)
     const CameraModel model = (CameraModel)GetParam();
     RNG rng(7);
     const Size size(320, 240);
-    VoxelGrid g;
-    const Matx33d Rb = rotationFromRodrigues(Vec3d(0.1, 0.5, -0.2));
-    g.create(Vec3i(70, 60, 50), Rb, Rb * Vec3d(-2.2, -2.0, -1.6), 0.065, 1);
-    std::vector<CarveView> views;
-    std::vector<Camera> cams;
-    for (int v = 0; v < 3; v++)
+    // Voxels of about 2.6 pixels (footprints of several pixels), of about 0.8 pixel (the affine
+    // walk's neighbour-mask test), and a grid that reaches off the image (unknown pixels).
+    const double edges[3] = {0.065, 0.02, 0.02};
+    const Vec3d shifts[3] = {Vec3d(0, 0, 0), Vec3d(0, 0, 0), Vec3d(3.2, 0.5, 0)};
+    for (int c = 0; c < 3; c++)
     {
-        cams.push_back(lookAtCamera(model, 40.0 * v - 30, 20, 30, size, 40));
-        views.push_back(g.carveView(cams.back(), blobMask(size, rng)));
+        VoxelGrid g;
+        const Matx33d Rb = rotationFromRodrigues(Vec3d(0.1, 0.5, -0.2));
+        const double h = edges[c];
+        const Vec3i dims(c == 0 ? 70 : 200, c == 0 ? 60 : 180, c == 0 ? 50 : 150);
+        g.create(dims, Rb, Rb * (Vec3d(-dims[0], -dims[1], -dims[2]) * (0.5 * h)) + shifts[c], h, 1);
+        std::vector<CarveView> views;
+        for (int v = 0; v < 3; v++)
+        {
+            const Camera cam = lookAtCamera(model, 40.0 * v - 30, 20, 30, size, 40);
+            views.push_back(g.carveView(cam, blobMask(size, rng)));
+        }
+        VoxelGrid fast = g;
+        fast.carve(views);
+        int64 mismatches = 0, kept = 0;
+        for (int k = 0; k < g.dims[2]; k++)
+            for (int j = 0; j < g.dims[1]; j++)
+                for (int i = 0; i < g.dims[0]; i++)
+                {
+                    bool keep = true;
+                    for (const CarveView& v : views)
+                        keep = keep && g.footprintKept(v, i, j, k);
+                    kept += keep;
+                    mismatches += keep != (fast.data[fast.index(i, j, k)] != 0);
+                }
+        EXPECT_EQ(mismatches, 0) << c;
+        EXPECT_GT(kept, 1000) << c;
+        EXPECT_LT(kept, g.total()) << c;
     }
-    VoxelGrid fast = g;
-    fast.carve(views);
-    int64 mismatches = 0, kept = 0;
-    for (int k = 0; k < g.dims[2]; k++)
-        for (int j = 0; j < g.dims[1]; j++)
-            for (int i = 0; i < g.dims[0]; i++)
-            {
-                bool keep = true;
-                for (const CarveView& v : views)
-                    keep = keep && g.footprintKept(v, i, j, k);
-                kept += keep;
-                mismatches += keep != (fast.data[fast.index(i, j, k)] != 0);
-            }
-    EXPECT_EQ(mismatches, 0);
-    EXPECT_GT(kept, 1000);
-    EXPECT_LT(kept, g.total());
 }
 
 INSTANTIATE_TEST_SUITE_P(/**/, Augocc_VoxelGrid_P, testing::Values((int)SCALED_ORTHOGRAPHIC,
@@ -88,6 +96,34 @@ TEST(Augocc_VoxelGrid, label_distance_matches_opencv)
     Mat ref = dk + dc, mine;
     labelDistance(m).convertTo(mine, CV_32F);
     EXPECT_MAT_NEAR(mine, ref, 0.0);
+}
+
+// The carve's one-pass quadrant distance against its definition, for all four quadrants and a roi.
+TEST(Augocc_VoxelGrid, quadrant_distance_matches_definition)
+{
+    RNG rng(11);
+    const Mat m = blobMask(Size(90, 70), rng);
+    const Rect roi(7, 5, 70, 55);
+    for (int sx : {-1, 1})
+        for (int sy : {-1, 1})
+        {
+            Mat d(m.size(), CV_8SC1, Scalar(0));
+            quadrantDistance(m, roi, sx, sy, d);
+            int bad = 0;
+            for (int y = roi.y; y < roi.br().y; y++)
+                for (int x = roi.x; x < roi.br().x; x++)
+                {
+                    const bool a = m.at<uchar>(y, x) != 0;
+                    int best = 127;
+                    for (int yy = roi.y; yy < roi.br().y; yy++)
+                        for (int xx = roi.x; xx < roi.br().x; xx++)
+                            if ((xx - x) * sx >= 0 && (yy - y) * sy >= 0 &&
+                                (m.at<uchar>(yy, xx) != 0) != a)
+                                best = std::min(best, std::max(std::abs(xx - x), std::abs(yy - y)));
+                    bad += d.at<schar>(y, x) != (a ? best : -best);
+                }
+            EXPECT_EQ(bad, 0) << sx << " " << sy;
+        }
 }
 
 TEST(Augocc_VoxelGrid, codec_roundtrip_and_surface)

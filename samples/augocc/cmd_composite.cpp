@@ -44,6 +44,7 @@ void runComposite(const Globals& g, const CompositeCliOptions& o)
     opt.mattesDir = o.mattes;
     opt.depthDir = o.depth;
     opt.virtualLayerDir = o.layer;
+    opt.reconstructionName = o.reconstruction;
     std::unique_ptr<Progress> progress;
     opt.progress = [&](int done, int total) {
         if (!progress)

@@ -92,61 +92,80 @@ void checkMask(const Mat& m, const Reconstruction& rec, const String& object, in
 // ---------------------------------------------------------------------------------------------
 // Step 1: clustering
 
+// Silhouette evidence of point X for `object`: -1 when a key frame where it is seen puts it outside
+// every silhouette of this object and of the others (it cannot be the object's), else the number
+// of key frames whose silhouette of this object holds it.
+int silhouetteVotes(const Reconstruction& rec, const ObjectMasks& all, const String& object,
+                    const Tracks* tracks, int p, const Vec3d& X)
+{
+    const FrameMasks& masks = all.at(object);
+    const Rect img(Point(0, 0), rec.imageSize);
+    int inCount = 0;
+    for (const auto& fm : masks)
+    {
+        const int f = fm.first;
+        if (tracks && (f >= tracks->frames() || !tracks->observed(f, p)))
+            continue;
+        const Point2d uv = rec.project(f, X);
+        const Point px(cvRound(uv.x), cvRound(uv.y));
+        if (!img.contains(px))
+        {
+            if (tracks)
+                return -1;  // seen in the frame but projects off it: inconsistent point
+            continue;
+        }
+        if (fm.second.at<uchar>(px) > 127)
+        {
+            inCount++;
+            continue;
+        }
+        // Under another object's silhouette the point may be hidden there: no evidence.
+        bool hidden = false;
+        for (const auto& other : all)
+        {
+            if (other.first == object)
+                continue;
+            auto it = other.second.find(f);
+            if (it != other.second.end() && it->second.at<uchar>(px) > 127)
+            {
+                hidden = true;
+                break;
+            }
+        }
+        if (!hidden)
+            return -1;
+    }
+    return inCount;
+}
+
+// Step 1: the points of `object`: consistent with its silhouettes (silhouetteVotes >= 1) and, when
+// they are consistent with other objects too (a point behind one object and seen inside another's
+// silhouette), held by this object's silhouettes in at least as many key frames as by any other's.
 std::vector<Vec3d> clusterPoints(const Reconstruction& rec, const ObjectMasks& all,
                                  const String& object, const Tracks* tracks)
 {
     std::vector<Vec3d> out;
     if (rec.points.empty())
         return out;
-    const FrameMasks& masks = all.at(object);
     const int P = rec.points.rows;
-    const Rect img(Point(0, 0), rec.imageSize);
     for (int p = 0; p < P; p++)
     {
         const double* q = rec.points.ptr<double>(p);
         if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
             continue;
         const Vec3d X(q[0], q[1], q[2]);
-        int inCount = 0;
-        bool ok = true;
-        for (const auto& fm : masks)
-        {
-            const int f = fm.first;
-            if (tracks && (f >= tracks->frames() || !tracks->observed(f, p)))
-                continue;
-            const Point2d uv = rec.project(f, X);
-            const Point px(cvRound(uv.x), cvRound(uv.y));
-            if (!img.contains(px))
+        const int mine = silhouetteVotes(rec, all, object, tracks, p, X);
+        if (mine <= 0)
+            continue;
+        bool best = true;
+        for (const auto& other : all)
+            if (other.first != object &&
+                silhouetteVotes(rec, all, other.first, tracks, p, X) > mine)
             {
-                if (tracks)
-                    ok = false;  // seen in the frame but projects off it: inconsistent point
-                continue;
-            }
-            if (fm.second.at<uchar>(px) > 127)
-            {
-                inCount++;
-                continue;
-            }
-            // Under another object's silhouette the point may be hidden there: no evidence.
-            bool hidden = false;
-            for (const auto& other : all)
-            {
-                if (other.first == object)
-                    continue;
-                auto it = other.second.find(f);
-                if (it != other.second.end() && it->second.at<uchar>(px) > 127)
-                {
-                    hidden = true;
-                    break;
-                }
-            }
-            if (!hidden)
-            {
-                ok = false;
+                best = false;
                 break;
             }
-        }
-        if (ok && inCount > 0)
+        if (best)
             out.push_back(X);
     }
     return out;
@@ -641,6 +660,96 @@ Mat unknownMask(const std::map<String, ObjectClone>& objs, const String& object,
     return unknown;
 }
 
+// Beyond Step 4, for objects hidden in part: voxels that no key frame shows as the object (their
+// centre's pixel is never in its silhouette: unknown under nearer objects, or off the image, in
+// every key frame) and that are not connected (6-neighbours) to any voxel a key frame does show
+// are pure conjecture: a piece of the box hidden in every key frame. They go. Voxels connected to
+// seen ones stay (the hidden part of a visible object). Returns the number removed.
+int64 dropUnseenComponents(ObjectClone& obj, const Reconstruction& rec)
+{
+    VoxelGrid& g = obj.grid;
+    const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+    std::vector<VoxelProjector> projs;
+    std::vector<const Mat*> masks;
+    for (const auto& fm : obj.masks)
+    {
+        projs.push_back(g.projector(rec.camera(fm.first), fm.second.size()));
+        masks.push_back(&fm.second);
+    }
+    // Seeds: voxels some key frame shows (marked 2).
+    const uchar kSeen = 2;
+    parallel_for_(Range(0, nz), [&](const Range& r) {
+        for (int k = r.start; k < r.end; k++)
+            for (int j = 0; j < ny; j++)
+            {
+                uchar* row = &g.data[g.index(0, j, k)];
+                for (int i = 0; i < nx; i++)
+                {
+                    if (!row[i])
+                        continue;
+                    for (size_t q = 0; q < projs.size(); q++)
+                    {
+                        int x0, x1, y0, y1;
+                        double z;
+                        if (!projs[q].footprint(i, j, k, x0, x1, y0, y1, z))
+                            continue;
+                        const double u = projs[q].M(0, 0) * i + (projs[q].M(0, 1) * j +
+                                         projs[q].M(0, 2) * k + projs[q].c[0]);
+                        const double v = projs[q].M(1, 0) * i + (projs[q].M(1, 1) * j +
+                                         projs[q].M(1, 2) * k + projs[q].c[1]);
+                        const double w = projs[q].affine ? 1.0
+                                         : projs[q].M(2, 0) * i + (projs[q].M(2, 1) * j +
+                                           projs[q].M(2, 2) * k + projs[q].c[2]);
+                        const Point px(cvRound(u / w), cvRound(v / w));
+                        if (px.x >= 0 && px.y >= 0 && px.x < masks[q]->cols &&
+                            px.y < masks[q]->rows && masks[q]->at<uchar>(px) > 127)
+                        {
+                            row[i] = kSeen;
+                            break;
+                        }
+                    }
+                }
+            }
+    });
+    // Flood from the seen voxels through alive ones (sequential: the result is a set, the same
+    // whatever the order).
+    std::vector<size_t> stack;
+    for (size_t n = 0; n < g.data.size(); n++)
+        if (g.data[n] == kSeen)
+            stack.push_back(n);
+    if (stack.empty())
+    {
+        // Nothing seen at all (silhouettes thinner than the voxel spacing): no evidence either
+        // way, keep the clone as carved.
+        for (uchar& v : g.data)
+            v = v ? 1 : 0;
+        return 0;
+    }
+    const size_t sy = (size_t)nx, sz = (size_t)nx * ny;
+    while (!stack.empty())
+    {
+        const size_t n = stack.back();
+        stack.pop_back();
+        const int i = (int)(n % sy), j = (int)((n / sy) % ny), k = (int)(n / sz);
+        const size_t nb[6] = {i > 0 ? n - 1 : n, i + 1 < nx ? n + 1 : n, j > 0 ? n - sy : n,
+                              j + 1 < ny ? n + sy : n, k > 0 ? n - sz : n,
+                              k + 1 < nz ? n + sz : n};
+        for (size_t m : nb)
+            if (g.data[m] == 1)
+            {
+                g.data[m] = kSeen;
+                stack.push_back(m);
+            }
+    }
+    int64 dropped = 0;
+    for (uchar& v : g.data)
+    {
+        dropped += v == 1;
+        v = v == kSeen ? 1 : 0;
+    }
+    return dropped;
+}
+
 void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
                    const Reconstruction& rec, const std::vector<int>& carveFrames,
                    bool occlusionAware, int raysPerPixel)
@@ -658,6 +767,15 @@ void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
         }
     });
     obj.grid.carve(views);
+    if (occlusionAware)
+    {
+        const int64 d = dropUnseenComponents(obj, rec);
+        if (d > 0)
+        {
+            CV_LOG_DEBUG(NULL, cv::format("augocc: object '%s': %lld voxels no key frame shows, "
+                         "apart from the seen ones, removed", obj.name.c_str(), (long long)d));
+        }
+    }
     obj.surface = obj.grid.surface();
     // Step 5 for every key frame (the clone changed, so every patch set is redone).
     std::vector<int> keys;

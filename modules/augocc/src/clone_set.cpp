@@ -389,15 +389,23 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
         l.n = it->second.size();
         lists.push_back(l);
     }
+    // Rendered straight into the caller's depth map; the matte only over the grid's bounds.
     Mat zmin;
+    if (depth.needed())
+    {
+        depth.create(imageSize, CV_32F);
+        zmin = depth.getMat();
+    }
     renderDepth(o.grid, proj, lists, zmin);
     if (matte.needed())
     {
-        Mat m = zmin < std::numeric_limits<float>::infinity();
-        m.copyTo(matte);
+        matte.create(imageSize, CV_8U);
+        Mat m = matte.getMat();
+        const Rect roi = o.grid.imageBounds(proj);
+        m.setTo(Scalar(0));
+        if (!roi.empty())
+            compare(zmin(roi), std::numeric_limits<float>::infinity(), m(roi), CMP_LT);
     }
-    if (depth.needed())
-        zmin.copyTo(depth);
 }
 
 void CloneSetImpl::save(const String& path) const

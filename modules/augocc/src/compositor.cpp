@@ -10,6 +10,7 @@
 #include "gl_context.hpp"
 #include "shading.hpp"
 
+#include <functional>
 #include <map>
 #include <tuple>
 #include <unordered_map>
@@ -43,7 +44,8 @@ Camera supersampledCamera(const Camera& camera, int factor)
 }
 
 Compositor::Params::Params()
-    : supersample(3), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2), lightRotation(Matx33d::eye())
+    : supersample(3), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2),
+      lightRotation(Matx33d::eye())
 {
 }
 
@@ -56,9 +58,11 @@ typedef void (*PfnDeleteBuffers)(GLsizei, const GLuint*);
 typedef void (*PfnBindBuffer)(GLenum, GLuint);
 typedef void (*PfnBufferData)(GLenum, ptrdiff_t, const void*, GLenum);
 typedef void (*PfnWindowPos2i)(GLint, GLint);
+typedef void (*PfnDrawRangeElements)(GLenum, GLuint, GLuint, GLsizei, GLenum, const void*);
 const GLenum kArrayBuffer = 0x8892;         // GL_ARRAY_BUFFER
 const GLenum kElementArrayBuffer = 0x8893;  // GL_ELEMENT_ARRAY_BUFFER
 const GLenum kStaticDraw = 0x88E4;          // GL_STATIC_DRAW
+const GLenum kStreamDraw = 0x88E0;          // GL_STREAM_DRAW
 
 struct GlBufferApi
 {
@@ -67,6 +71,7 @@ struct GlBufferApi
     PfnBindBuffer bindBuffer = nullptr;
     PfnBufferData bufferData = nullptr;
     PfnWindowPos2i windowPos2i = nullptr;
+    PfnDrawRangeElements drawRangeElements = nullptr;
 
     void load()
     {
@@ -77,7 +82,9 @@ struct GlBufferApi
         bindBuffer = (PfnBindBuffer)OSMesaGetProcAddress("glBindBuffer");
         bufferData = (PfnBufferData)OSMesaGetProcAddress("glBufferData");
         windowPos2i = (PfnWindowPos2i)OSMesaGetProcAddress("glWindowPos2i");
-        if (!genBuffers || !deleteBuffers || !bindBuffer || !bufferData || !windowPos2i)
+        drawRangeElements = (PfnDrawRangeElements)OSMesaGetProcAddress("glDrawRangeElements");
+        if (!genBuffers || !deleteBuffers || !bindBuffer || !bufferData || !windowPos2i ||
+            !drawRangeElements)
             CV_Error(Error::StsError, "OSMesa: OpenGL 1.5 entry points are not available");
     }
 };
@@ -96,7 +103,12 @@ struct GpuMesh
 {
     GLuint vbo = 0, ibo = 0, texture = 0;
     GLsizei indexCount = 0;
+    GLuint vertexCount = 0;
     bool cull = false;  // closed and outward: back faces are never seen
+    // Culled meshes only: per face, its first vertex and unit normal (zero when degenerate),
+    // for the back-face test on the CPU; the faces that pass it are streamed into `keptIbo`.
+    std::vector<Vec3f> faceOrigin, faceNormal;
+    GLuint keptIbo = 0;
 };
 
 // True when the mesh is closed and consistently oriented with outward normals (vertices welded by
@@ -199,32 +211,58 @@ public:
         return Size(frameSize.width * params_.supersample, frameSize.height * params_.supersample);
     }
 
-    void composite(InputArray frame, int frameIndex, const Camera& camera, const CloneSet& clones,
-                   OutputArray result, OutputArray virtualLayer, OutputArray depth) CV_OVERRIDE
+    void composite(InputArray frameArr, int frameIndex, const Camera& camera,
+                   const CloneSet& clones, OutputArray result, OutputArray virtualLayer,
+                   OutputArray depthOut) CV_OVERRIDE
     {
-        const Size fsz = frame.size();
-        const Size rsz = renderSize(fsz);
-        const Camera rc = supersampledCamera(camera, params_.supersample);
-        Mat occ(rsz, CV_32F, Scalar::all(std::numeric_limits<float>::infinity()));
-        Mat matte, d;
-        for (const String& name : clones.objectNames())
+        const Mat frame = checkedFrame(frameArr, camera);
+        const Size rsz = renderSize(frame.size());
+        const FramePlan pl = plan(camera, rsz);
+        // The clones are rendered only where the occluder depth is used: the whole render grid
+        // for the depth output; else only the bounding box of the samples the virtual objects
+        // cover (known once they are drawn: tighter than the ROI, which bounds their 3D box),
+        // with the camera shifted by its corner (an integer shift of the principal point: the
+        // same pixels). The depth test reads the occluder at covered samples only.
+        const bool needZ = depthOut.needed();
+        const float inf = std::numeric_limits<float>::infinity();
+        auto renderClones = [&](const Rect& area, Mat& occ) {
+            const Camera ac = shiftedCamera(pl.rc, area.tl());
+            for (const String& name : clones.objectNames())
+            {
+                // The matte is not an optional output of CloneSet::render(): a reused buffer.
+                clones.render(name, frameIndex, ac, area.size(), cloneMatte_, cloneDepth_);
+                CV_CheckTypeEQ(cloneDepth_.type(), CV_32FC1, "clone depth must be CV_32F");
+                CV_CheckEQ(cloneDepth_.size(), area.size(), "clone depth size");
+                cv::min(occ, cloneDepth_, occ);
+            }
+        };
+        if (needZ)
         {
-            clones.render(name, frameIndex, rc, rsz, matte, d);
-            CV_CheckTypeEQ(d.type(), CV_32FC1, "clone depth must be CV_32F");
-            CV_CheckEQ(d.size(), rsz, "clone depth size");
-            cv::min(occ, d, occ);
+            cloneOcc_.create(rsz, CV_32F);
+            cloneOcc_.setTo(Scalar::all(inf));
+            renderClones(Rect(Point(), rsz), cloneOcc_);
+            const Mat occRoi = pl.roi.area() > 0 ? cloneOcc_(pl.roi) : Mat();
+            compositeCore(frame, camera, pl, [&](const Mat&) { return occRoi; }, cloneOcc_,
+                          result, virtualLayer, depthOut);
+            return;
         }
-        composite(frame, camera, occ, result, virtualLayer, depth);
+        auto occluderOf = [&](const Mat& rgbaUp) {
+            const Rect cov = coveredRect(rgbaUp);
+            if (cov.area() == 0)
+                return Mat();
+            cloneOcc_.create(pl.roi.size(), CV_32F);
+            cloneOcc_.setTo(Scalar::all(inf));
+            Mat sub = cloneOcc_(cov);
+            renderClones(cov + pl.roi.tl(), sub);
+            return cloneOcc_;
+        };
+        compositeCore(frame, camera, pl, occluderOf, Mat(), result, virtualLayer, depthOut);
     }
 
     void composite(InputArray frameArr, const Camera& camera, InputArray occluderArr,
                    OutputArray result, OutputArray virtualLayer, OutputArray depthOut) CV_OVERRIDE
     {
-        Mat frame = frameArr.getMat();
-        if (frame.empty())
-            CV_Error(Error::StsBadArg, "Compositor: empty frame");
-        CV_CheckTypeEQ(frame.type(), CV_8UC3, "Compositor: frame must be BGR CV_8UC3");
-        camera.validate("Compositor camera");
+        const Mat frame = checkedFrame(frameArr, camera);
         const int k = params_.supersample;
         const Size fsz = frame.size();
         const Size rsz = renderSize(fsz);
@@ -245,10 +283,35 @@ public:
                          "expected %dx%d or %dx%d", occ.cols, occ.rows, rsz.width, rsz.height,
                          fsz.width, fsz.height));
         }
+        const FramePlan pl = plan(camera, rsz);
+        const Mat occRoi = (occ.empty() || pl.roi.area() == 0) ? Mat() : occ(pl.roi);
+        compositeCore(frame, camera, pl, [&](const Mat&) { return occRoi; }, occ, result,
+                      virtualLayer, depthOut);
+    }
 
-        ensureContext(rsz);
-        uploadIfDirty();
+private:
+    // What a frame needs before drawing: the depth range that holds the virtual objects, the
+    // camera of the render grid and the part of that grid where the virtual objects can appear.
+    struct FramePlan
+    {
+        double zNear = 0, zFar = 1;
+        Camera rc;
+        Rect roi;  // render grid, a multiple of k, so that it maps onto whole frame pixels
+    };
 
+    static Mat checkedFrame(InputArray frameArr, const Camera& camera)
+    {
+        Mat frame = frameArr.getMat();
+        if (frame.empty())
+            CV_Error(Error::StsBadArg, "Compositor: empty frame");
+        CV_CheckTypeEQ(frame.type(), CV_8UC3, "Compositor: frame must be BGR CV_8UC3");
+        camera.validate("Compositor camera");
+        return frame;
+    }
+
+    FramePlan plan(const Camera& camera, Size rsz) const
+    {
+        FramePlan pl;
         // Depth range that holds the virtual objects. Occluders nearer than the near plane clamp
         // to window depth 0 (they hide everything), farther than the far plane to 1 (nothing).
         double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
@@ -259,48 +322,103 @@ public:
                 zmin = std::min(zmin, z);
                 zmax = std::max(zmax, z);
             }
-        double zNear = 0, zFar = 1;
-        chooseDepthRange(camera, zmin, zmax, zNear, zFar);
-        const Camera rc = supersampledCamera(camera, k);
+        chooseDepthRange(camera, zmin, zmax, pl.zNear, pl.zFar);
+        pl.rc = supersampledCamera(camera, params_.supersample);
         // Only the part of the render grid where the virtual objects can appear is drawn, read
-        // back and blended (a multiple of k, so that it maps onto whole frame pixels).
-        const Rect roi = meshes_.empty() ? Rect() : screenRoi(rc, rsz, k, zNear);
+        // back and blended.
+        pl.roi = meshes_.empty() ? Rect() : screenRoi(pl.rc, rsz, params_.supersample, pl.zNear);
+        return pl;
+    }
 
-        Mat layerRoi;  // frame grid, ROI only: premultiplied RGB + alpha, CV_32FC4, top-down
-        Mat zRoi;      // render grid, ROI only: camera z of the virtual surface (+inf: none)
+    // The camera of the sub-image whose top-left pixel is `corner` of the camera's image.
+    static Camera shiftedCamera(const Camera& camera, Point corner)
+    {
+        Camera c = camera;
+        if (camera.model == SCALED_ORTHOGRAPHIC)
+            c.pp = Point2d(camera.pp.x - corner.x, camera.pp.y - corner.y);
+        else
+        {
+            c.K(0, 2) = camera.K(0, 2) - corner.x;
+            c.K(1, 2) = camera.K(1, 2) - corner.y;
+            c.pp = Point2d(c.K(0, 2), c.K(1, 2));
+        }
+        return c;
+    }
+
+    // Bounding box, top-down in the ROI, of the samples the virtual objects cover in the
+    // read-back colour (GL rows bottom-up).
+    static Rect coveredRect(const Mat& rgbaUp)
+    {
+        Mat alpha;
+        cv::extractChannel(rgbaUp, alpha, 3);
+        const Rect r = cv::boundingRect(alpha);  // non-zero pixels of a CV_8U image
+        if (r.area() == 0)
+            return Rect();
+        return Rect(r.x, rgbaUp.rows - r.y - r.height, r.width, r.height);
+    }
+
+    // Draws, reads back, resolves against the occluder and blends. occluderOf(rgbaUp): the
+    // occluder depth over pl.roi, right at least at the samples rgbaUp covers (empty: nothing
+    // occludes); occFull: over the render grid, for the depth output only (empty: nothing).
+    void compositeCore(const Mat& frame, const Camera& camera, const FramePlan& pl,
+                       const std::function<Mat(const Mat&)>& occluderOf, const Mat& occFull,
+                       OutputArray result, OutputArray virtualLayer, OutputArray depthOut)
+    {
+        const int k = params_.supersample;
+        const Size fsz = frame.size();
+        const Size rsz = renderSize(fsz);
+        ensureContext(rsz);
+        uploadIfDirty();
+        const Rect& roi = pl.roi;
+        const double zNear = pl.zNear, zFar = pl.zFar;
+
+        // layerRoi_: frame grid, ROI only: premultiplied RGB + alpha, CV_32FC4, top-down.
+        // zRoi_: render grid, ROI only: camera z of the virtual surface (+inf: none).
+        // Buffers are members, reused from frame to frame.
+        const bool needZ = depthOut.needed();
         if (roi.area() > 0)
         {
             const int winY = rsz.height - roi.y - roi.height;
-            glEnable(GL_SCISSOR_TEST);
-            glScissor(roi.x, winY, roi.width, roi.height);
+            // A clear of the whole buffer (colour, depth and stencil together) is a fast clear in
+            // llvmpipe; a scissored one draws a quad through the fragment shader. Only the ROI is
+            // read, so either is right: the fast one while the ROI is a good part of the buffer.
             glClearColor(0, 0, 0, 0);
             glClearDepth(1.0);
-            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            glClearStencil(0);
+            const bool wholeClear = 4 * (double)roi.area() >= (double)rsz.area();
+            if (wholeClear)
+                glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(roi.x, winY, roi.width, roi.height);
+            if (!wholeClear)
+                glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
             glDisable(GL_LIGHTING);
             glDisable(GL_BLEND);
             glDisable(GL_DITHER);
             glEnable(GL_DEPTH_TEST);
-            drawMeshes(rc, rsz, zNear, zFar);
-            glFinish();
-            Mat rgbaUp(roi.size(), CV_8UC4), depthUp(roi.size(), CV_32F);
+            drawMeshes(pl.rc, rsz, zNear, zFar);
+            // glReadPixels waits for the rasteriser itself: no glFinish. RGBA bytes are the
+            // buffer's own format (a plain copy in Mesa); the channel order is handled in
+            // resolve().
+            rgbaUp_.create(roi.size(), CV_8UC4);
+            depthUp_.create(roi.size(), CV_32F);
             glPixelStorei(GL_PACK_ALIGNMENT, 4);
             glReadPixels(roi.x, winY, roi.width, roi.height, GL_RGBA, GL_UNSIGNED_BYTE,
-                         rgbaUp.data);
+                         rgbaUp_.data);
             glReadPixels(roi.x, winY, roi.width, roi.height, GL_DEPTH_COMPONENT, GL_FLOAT,
-                         depthUp.data);
+                         depthUp_.data);
             glDisable(GL_SCISSOR_TEST);
             frameRoi_ = frame(Rect(roi.x / k, roi.y / k, roi.width / k, roi.height / k));
-            resolve(camera, rgbaUp, depthUp, occ.empty() ? Mat() : occ(roi), zNear, zFar, k,
-                    layerRoi, zRoi);
+            const Mat occRoi = occluderOf(rgbaUp_);
+            resolve(camera, rgbaUp_, depthUp_, occRoi, zNear, zFar, k, needZ, layerRoi_, zRoi_);
         }
         const Rect froi(roi.x / k, roi.y / k, roi.width / k, roi.height / k);
-        blend(frame, layerRoi, froi, result, virtualLayer);
+        blend(frame, layerRoi_, froi, result, virtualLayer);
         frameRoi_ = Mat();
-        if (depthOut.needed())
-            writeDepth(occ, zRoi, roi, rsz, fsz, k, depthOut);
+        if (needZ)
+            writeDepth(occFull, zRoi_, roi, rsz, fsz, k, depthOut);
     }
 
-private:
     void ensureContext(Size rsz)
     {
         if (!gl_)
@@ -325,6 +443,8 @@ private:
                 glApi_.deleteBuffers(1, &g.vbo);
             if (g.ibo)
                 glApi_.deleteBuffers(1, &g.ibo);
+            if (g.keptIbo)
+                glApi_.deleteBuffers(1, &g.keptIbo);
             if (g.texture)
                 glDeleteTextures(1, &g.texture);
         }
@@ -369,7 +489,27 @@ private:
             glApi_.bufferData(kElementArrayBuffer, (ptrdiff_t)(m.faces.size() * sizeof(Vec3i)),
                                 m.faces.data(), kStaticDraw);
             g.indexCount = (GLsizei)(m.faces.size() * 3);
+            g.vertexCount = (GLuint)nv;
             g.cull = params_.cullBackFaces && closedOutward(m);
+            if (g.cull)
+            {
+                const int nf = (int)m.faces.size();
+                g.faceOrigin.resize(nf);
+                g.faceNormal.resize(nf);
+                cv::parallel_for_(Range(0, nf), [&](const Range& r) {
+                    for (int i = r.start; i < r.end; i++)
+                    {
+                        const Vec3i& f = m.faces[i];
+                        const Vec3d p0(m.vertices[f[0]]), p1(m.vertices[f[1]]),
+                            p2(m.vertices[f[2]]);
+                        const Vec3d n = (p1 - p0).cross(p2 - p0);
+                        const double len = cv::norm(n);
+                        g.faceOrigin[i] = m.vertices[f[0]];
+                        g.faceNormal[i] = len > 0 ? Vec3f(n / len) : Vec3f(0, 0, 0);
+                    }
+                });
+                glApi_.genBuffers(1, &g.keptIbo);
+            }
             if (hasTex)
                 g.texture = uploadTexture(m.material.texture);
             gpu_.push_back(g);
@@ -447,7 +587,8 @@ private:
 
     Vec3d boundsCorner(int c) const
     {
-        return Vec3d((c & 1) ? boundsMax_[0] : boundsMin_[0], (c & 2) ? boundsMax_[1] : boundsMin_[1],
+        return Vec3d((c & 1) ? boundsMax_[0] : boundsMin_[0],
+                     (c & 2) ? boundsMax_[1] : boundsMin_[1],
                      (c & 4) ? boundsMax_[2] : boundsMin_[2]);
     }
 
@@ -486,81 +627,88 @@ private:
     // average to the frame grid: camera z of each virtual sample (from its window depth) against
     // the occluder's camera z, so that both compare in one metric whatever the camera model.
     // Output per frame pixel: the visible virtual colour (premultiplied) and coverage; with soft
-    // edges, the visible fraction refined on the frame by a guided filter near the occlusion
-    // boundary.
+    // edges and edgeRadius > 0, the visible fraction refined on the frame by a guided filter near
+    // the occlusion boundary. zVirtual (render grid) is filled only when `needZ`.
     void resolve(const Camera& cam, const Mat& rgbaUp, const Mat& depthUp, const Mat& occ,
-                 double zNear, double zFar, int k, Mat& layer, Mat& zVirtual) const
+                 double zNear, double zFar, int k, bool needZ, Mat& layer, Mat& zVirtual)
     {
         const Size up = rgbaUp.size(), sz(up.width / k, up.height / k);
         const bool ortho = cam.model == SCALED_ORTHOGRAPHIC;
         const float inf = std::numeric_limits<float>::infinity();
-        zVirtual.create(up, CV_32F);
+        const bool refine = !occ.empty() && params_.edgeRadius > 0 && frameRoi_.data;
+        if (needZ)
+            zVirtual.create(up, CV_32F);
         layer.create(sz, CV_32FC4);
         // Visible fraction of the virtual coverage and the unoccluded premultiplied colour,
-        // for the refinement.
-        Mat visFrac(sz, CV_32F), allColor(sz, CV_32FC4);
-        const float inv = 1.f / (255.f * k * k), invN = 1.f / (k * k);
+        // for the refinement only.
+        if (refine)
+        {
+            visFrac_.create(sz, CV_32F);
+            allColor_.create(sz, CV_32FC4);
+        }
+        const float inv = 1.f / (255.f * k * k);
+        // Window depth d to camera z (the inverse of glProjection's depth row).
+        const double zSum = zFar + zNear, zDiff = zFar - zNear, zProd2 = 2 * zFar * zNear;
         cv::parallel_for_(Range(0, sz.height), [&](const Range& r) {
+            // Per frame-grid row: sums over the k x k samples of every pixel (integers, exact in
+            // float whatever the order). vis: visible samples, tot: all covered samples.
+            std::vector<float> sums(8 * (size_t)sz.width), zRow(up.width);
             for (int y = r.start; y < r.end; y++)
             {
+                std::fill(sums.begin(), sums.end(), 0.f);
                 for (int j = 0; j < k; j++)
                 {
                     const int yu = y * k + j;  // top-down row of the render grid
                     const float* d = depthUp.ptr<float>(up.height - 1 - yu);
                     const uchar* c = rgbaUp.ptr<uchar>(up.height - 1 - yu);
-                    float* zo = zVirtual.ptr<float>(yu);
+                    const float* zo = occ.empty() ? nullptr : occ.ptr<float>(yu);
+                    float* zv = needZ ? zVirtual.ptr<float>(yu) : zRow.data();
                     for (int x = 0; x < up.width; x++)
                     {
-                        if (c[4 * x + 3] == 0)
+                        const uchar* cx = c + 4 * x;
+                        if (cx[3] == 0)
                         {
-                            zo[x] = inf;
+                            zv[x] = inf;
                             continue;
                         }
                         const double ndc = 2.0 * d[x] - 1.0;
-                        zo[x] = ortho ? (float)(0.5 * (ndc * (zFar - zNear) + zFar + zNear))
-                                      : (float)(2 * zFar * zNear /
-                                                ((zFar + zNear) - ndc * (zFar - zNear)));
+                        zv[x] = ortho ? (float)(0.5 * (ndc * zDiff + zSum))
+                                      : (float)(zProd2 / (zSum - ndc * zDiff));
+                        float* t = &sums[8 * (size_t)(x / k)];
+                        t[4] += cx[2];
+                        t[5] += cx[1];
+                        t[6] += cx[0];
+                        t[7] += 255.f;
+                        if (zo && !(zv[x] < zo[x]))
+                            continue;  // a real object is in front
+                        t[0] += cx[2];
+                        t[1] += cx[1];
+                        t[2] += cx[0];
+                        t[3] += 255.f;
                     }
                 }
                 Vec4f* out = layer.ptr<Vec4f>(y);
-                Vec4f* all = allColor.ptr<Vec4f>(y);
-                float* vf = visFrac.ptr<float>(y);
                 for (int x = 0; x < sz.width; x++)
                 {
-                    float vis[4] = {0, 0, 0, 0}, tot[4] = {0, 0, 0, 0};
-                    for (int j = 0; j < k; j++)
-                    {
-                        const int yu = y * k + j;
-                        const uchar* c = rgbaUp.ptr<uchar>(up.height - 1 - yu) + 4 * x * k;
-                        const float* zv = zVirtual.ptr<float>(yu) + x * k;
-                        const float* zo = occ.empty() ? nullptr : occ.ptr<float>(yu) + x * k;
-                        for (int i = 0; i < k; i++, c += 4)
-                        {
-                            if (c[3] == 0)
-                                continue;
-                            tot[0] += c[2];
-                            tot[1] += c[1];
-                            tot[2] += c[0];
-                            tot[3] += 255.f;
-                            if (zo && !(zv[i] < zo[i]))
-                                continue;  // a real object is in front
-                            vis[0] += c[2];
-                            vis[1] += c[1];
-                            vis[2] += c[0];
-                            vis[3] += 255.f;
-                        }
-                    }
+                    const float* t = &sums[8 * (size_t)x];
                     // BGR premultiplied, in [0, 1].
-                    out[x] = Vec4f(vis[0] * inv, vis[1] * inv, vis[2] * inv, vis[3] * inv);
-                    all[x] = Vec4f(tot[0] * inv, tot[1] * inv, tot[2] * inv, tot[3] * inv);
-                    vf[x] = tot[3] > 0 ? vis[3] / tot[3] : 1.f;
+                    out[x] = Vec4f(t[0] * inv, t[1] * inv, t[2] * inv, t[3] * inv);
+                }
+                if (refine)
+                {
+                    Vec4f* all = allColor_.ptr<Vec4f>(y);
+                    float* vf = visFrac_.ptr<float>(y);
+                    for (int x = 0; x < sz.width; x++)
+                    {
+                        const float* t = &sums[8 * (size_t)x];
+                        all[x] = Vec4f(t[4] * inv, t[5] * inv, t[6] * inv, t[7] * inv);
+                        vf[x] = t[7] > 0 ? t[3] / t[7] : 1.f;
+                    }
                 }
             }
         });
-        (void)invN;
-        if (occ.empty() || params_.edgeRadius <= 0 || !frameRoi_.data)
-            return;
-        refineOcclusion(visFrac, allColor, layer);
+        if (refine)
+            refineOcclusion(visFrac_, allColor_, layer);
     }
 
     // Soft occlusion edges beyond the supersampling: where a clone hides part of a virtual
@@ -627,14 +775,28 @@ private:
         // the camera.
         glFrontFace(GL_CCW);
         glCullFace(GL_BACK);
-        for (const GpuMesh& g : gpu_)
+        for (size_t mi = 0; mi < gpu_.size(); mi++)
         {
+            const GpuMesh& g = gpu_[mi];
+            GLsizei indexCount = g.indexCount;
             if (g.cull)
+            {
                 glEnable(GL_CULL_FACE);
+                frontFaces(g, cam, meshes_[mi].faces, keptFaces_);
+                indexCount = (GLsizei)(3 * keptFaces_.size());
+                if (indexCount == 0)
+                    continue;
+                glApi_.bindBuffer(kElementArrayBuffer, g.keptIbo);
+                glApi_.bufferData(kElementArrayBuffer,
+                                  (ptrdiff_t)(keptFaces_.size() * sizeof(Vec3i)),
+                                  keptFaces_.data(), kStreamDraw);
+            }
             else
+            {
                 glDisable(GL_CULL_FACE);
+                glApi_.bindBuffer(kElementArrayBuffer, g.ibo);
+            }
             glApi_.bindBuffer(kArrayBuffer, g.vbo);
-            glApi_.bindBuffer(kElementArrayBuffer, g.ibo);
             glVertexPointer(3, GL_FLOAT, sizeof(GpuVertex), (const void*)offsetof(GpuVertex, x));
             glColorPointer(3, GL_FLOAT, sizeof(GpuVertex), (const void*)offsetof(GpuVertex, r));
             if (g.texture)
@@ -645,7 +807,9 @@ private:
                 glTexCoordPointer(2, GL_FLOAT, sizeof(GpuVertex),
                                   (const void*)offsetof(GpuVertex, u));
             }
-            glDrawElements(GL_TRIANGLES, g.indexCount, GL_UNSIGNED_INT, nullptr);
+            // The index range is known: Mesa need not scan the indices for it.
+            glApi_.drawRangeElements(GL_TRIANGLES, 0, g.vertexCount - 1, indexCount,
+                                     GL_UNSIGNED_INT, nullptr);
             if (g.texture)
             {
                 glDisableClientState(GL_TEXTURE_COORD_ARRAY);
@@ -658,6 +822,62 @@ private:
         glDisableClientState(GL_COLOR_ARRAY);
         glApi_.bindBuffer(kArrayBuffer, 0);
         glApi_.bindBuffer(kElementArrayBuffer, 0);
+    }
+
+    // The faces of a culled mesh that may face the camera, in their order. The rasteriser would
+    // cull the others anyway, but only after fetching and transforming their vertices and
+    // assembling them: a plane test per face on the CPU costs far less. A face is dropped only
+    // when it faces away by more than kEdgeOnCos (the cosine between its normal and the viewing
+    // ray), so that the rasteriser still decides the nearly edge-on ones from its own window
+    // coordinates and the pixels are exactly those of GL culling alone (tested). camera.validate()
+    // guarantees det R = 1 and positive focal lengths, so no mirroring flips the facing.
+    static void frontFaces(const GpuMesh& g, const Camera& cam, const std::vector<Vec3i>& faces,
+                           std::vector<Vec3i>& kept)
+    {
+        const float kEdgeOnCos = 1e-2f;  // 0.6 deg: far above float rounding of the window area
+        const int nf = (int)faces.size();
+        const bool ortho = cam.model == SCALED_ORTHOGRAPHIC;
+        const Vec3f c(cam.center());
+        const Vec3f dir((float)cam.R(2, 0), (float)cam.R(2, 1), (float)cam.R(2, 2));
+        // Fixed blocks (not thread chunks): the output does not depend on the thread count.
+        const int kBlock = 8192;
+        const int nb = (nf + kBlock - 1) / kBlock;
+        std::vector<int> offset(nb + 1, 0);
+        std::vector<uchar> keep(nf);
+        cv::parallel_for_(Range(0, nb), [&](const Range& r) {
+            for (int b = r.start; b < r.end; b++)
+            {
+                int count = 0;
+                for (int i = b * kBlock, e = std::min(nf, i + kBlock); i < e; i++)
+                {
+                    const Vec3f& n = g.faceNormal[i];
+                    bool back;
+                    if (ortho)
+                        back = n.dot(dir) > kEdgeOnCos;
+                    else
+                    {
+                        const Vec3f d = g.faceOrigin[i] - c;  // viewing ray to the face
+                        const float dn = d.dot(n);
+                        back = dn > 0 && dn * dn > kEdgeOnCos * kEdgeOnCos * d.dot(d);
+                    }
+                    keep[i] = back ? 0 : 1;
+                    count += keep[i];
+                }
+                offset[b + 1] = count;
+            }
+        });
+        for (int b = 0; b < nb; b++)
+            offset[b + 1] += offset[b];
+        kept.resize(offset[nb]);
+        cv::parallel_for_(Range(0, nb), [&](const Range& r) {
+            for (int b = r.start; b < r.end; b++)
+            {
+                Vec3i* out = kept.data() + offset[b];
+                for (int i = b * kBlock, e = std::min(nf, i + kBlock); i < e; i++)
+                    if (keep[i])
+                        *out++ = faces[i];
+            }
+        });
     }
 
     // result = frame * (1 - a) + premultiplied colour inside `roi` (frame grid); the frame
@@ -747,7 +967,10 @@ private:
     std::unique_ptr<detail::GlContext> gl_;
     GlBufferApi glApi_;
     std::vector<GpuMesh> gpu_;
+    std::vector<Vec3i> keptFaces_;  // frontFaces() of the mesh being drawn (reused)
     Mat frameRoi_;  // the frame under the ROI, guide of the refinement (during composite())
+    Mat rgbaUp_, depthUp_, zRoi_, layerRoi_, visFrac_, allColor_;  // per-frame buffers, reused
+    Mat cloneOcc_, cloneDepth_, cloneMatte_;  // composite(..., clones, ...), reused
 };
 
 } // namespace

@@ -31,8 +31,16 @@ public:
     explicit PendingOutput(const String& path) : path_(path)
     {
         fs::path p(path);
-        if (p.has_parent_path())
+        if (p.has_parent_path() && !fs::exists(p.parent_path()))
+        {
+            // Folders made here go again on failure (the first one made is enough to remove).
+            fs::path top = p.parent_path();
+            while (top.has_parent_path() && top.parent_path() != top &&
+                   !top.parent_path().empty() && !fs::exists(top.parent_path()))
+                top = top.parent_path();
+            madeDir_ = top.string();
             fs::create_directories(p.parent_path());
+        }
         const String name = "." + p.stem().string() +
                             cv::format(".tmp%d", (int)(cv::getTickCount() & 0xffffff)) +
                             p.extension().string();
@@ -44,6 +52,14 @@ public:
         {
             std::error_code ec;
             fs::remove_all(tmp_, ec);
+            // Empty folders only, from the output's up to the outermost one made here.
+            if (!madeDir_.empty())
+                for (fs::path d = fs::path(path_).parent_path(); !d.empty();
+                     d = d.parent_path())
+                {
+                    if (!fs::remove(d, ec) || d == fs::path(madeDir_))
+                        break;
+                }
         }
     }
     const String& tmp() const { return tmp_; }
@@ -60,6 +76,7 @@ public:
 
 private:
     String path_, tmp_;
+    String madeDir_;  // outermost folder created for the output, if any
     bool committed_ = false;
 };
 
@@ -176,18 +193,21 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
     if (first < 0 || first >= end || end > count)
         CV_Error(Error::StsOutOfRange, input + cv::format(": frames %d:%d out of range, the input "
                  "has %d frames (0:%d)", first, end, count, count));
-    rec.validate("reconstruction");
+    const String& recName = options.reconstructionName;
+    rec.validate(recName);
     if (rec.imageSize != src->size())
-        CV_Error(Error::StsBadSize, input + cv::format(": frames are %dx%d but the reconstruction's "
-                 "image_size is %dx%d", src->size().width, src->size().height,
-                 rec.imageSize.width, rec.imageSize.height));
+        CV_Error(Error::StsBadSize, input + cv::format(": frames are %dx%d but the image_size of ",
+                 src->size().width, src->size().height) + recName +
+                 cv::format(" is %dx%d: they do not belong together", rec.imageSize.width,
+                 rec.imageSize.height));
     if (!rec.cameras.empty() && rec.cameras.back().frame >= count)
-        CV_Error(Error::StsBadArg, input + cv::format(": the reconstruction has a camera for frame "
-                 "%d but the input has %d frames: they do not belong together",
-                 rec.cameras.back().frame, count));
+        CV_Error(Error::StsBadArg, input + cv::format(": the input has %d frames but ", count) +
+                 recName + cv::format(" has a camera for frame %d: they do not belong together",
+                 rec.cameras.back().frame));
     for (int f = first; f < end; f++)
         if (rec.findCamera(f) < 0)
-            CV_Error(Error::StsBadArg, cv::format("reconstruction: frame %d has no camera", f));
+            CV_Error(Error::StsBadArg, recName + cv::format(": frame %d has no camera (frames "
+                     "%d:%d are to be composited)", f, first, end));
 
     const bool video = isVideoPath(output);
     PendingOutput out(output);
@@ -480,15 +500,42 @@ RunResult runPipeline(const RunOptions& o)
     const ObjectMasks masks = readMasks(o.masksDir, src->size());
     if (masks.empty())
         CV_Error(Error::StsBadArg, o.masksDir + ": no object folder with masks");
+    const int frameCount = src->count();
+    for (const auto& obj : masks)
+        for (const auto& fm : obj.second)
+            if (fm.first >= frameCount)
+                CV_Error(Error::StsBadArg, (fs::path(o.masksDir) / obj.first /
+                         cv::format("%04d.png", fm.first)).string() + cv::format(": a mask for "
+                         "frame %d but %s has %d frames: they do not belong together", fm.first,
+                         o.input.c_str(), frameCount));
     VirtualScene scene;
     if (!o.scenePath.empty())
         scene = readScene(o.scenePath);
+    // An output folder made here and still empty when a stage fails goes again. Intermediate
+    // files already written stay: each is complete (written atomically) and re-runs by hand.
+    struct EmptyDirGuard
+    {
+        String dir;
+        ~EmptyDirGuard()
+        {
+            std::error_code ec;
+            if (!dir.empty())
+                fs::remove(dir, ec);
+        }
+    } guard;
+    if (!fs::exists(o.outDir))
+        guard.dir = o.outDir;
     fs::create_directories(o.outDir);
     const fs::path dir(o.outDir);
 
     timer.start();
     progress("track", 0, src->count());
     FeatureTracker::create()->track(src, r.tracks, [&](int d, int t) { progress("track", d, t); });
+    // A video cut short or corrupt mid-stream ends early: found here, before anything is
+    // written, not later as cameras missing for the masks' frames.
+    if (r.tracks.frames() != frameCount)
+        CV_Error(Error::StsParseError, o.input + cv::format(": %d frames decoded of the %d the "
+                 "input declares (cut short or corrupt)", r.tracks.frames(), frameCount));
     writeTracks((dir / "tracks.yml").string(), r.tracks);
     timer.stop("track");
 
@@ -527,6 +574,7 @@ RunResult runPipeline(const RunOptions& o)
                           r.compositePath, co);
         timer.stop("composite");
     }
+    guard.dir.clear();
     return r;
 }
 
@@ -667,12 +715,14 @@ DemoResult runDemo(const DemoOptions& o)
     for (size_t i = 0; i < before.size(); i++)
     {
         sheet.push_back(before[i]);
-        captions.push_back(cv::format("frame %d: input", (int)(i * ((n - 1) / (kSheetFrames - 1)))));
+        captions.push_back(cv::format("frame %d: input",
+                                      (int)(i * ((n - 1) / (kSheetFrames - 1)))));
     }
     for (size_t i = 0; i < after.size(); i++)
     {
         sheet.push_back(after[i]);
-        captions.push_back(cv::format("frame %d: composite", (int)(i * ((n - 1) / (kSheetFrames - 1)))));
+        captions.push_back(cv::format("frame %d: composite",
+                                      (int)(i * ((n - 1) / (kSheetFrames - 1)))));
     }
     res.contactSheetPath = (dir / "contact_sheet.png").string();
     const Mat sheetImg = makeContactSheet(sheet, captions, (int)before.size(), 320);

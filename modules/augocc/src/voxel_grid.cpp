@@ -6,6 +6,7 @@
 
 #include <climits>
 #include <cstring>
+#include <memory>
 
 namespace cv {
 namespace augocc {
@@ -16,6 +17,8 @@ namespace {
 // Margin subtracted from distances before skipping, so that rounding never lets a skip cross a
 // label change (distances are integers; steps are in pixels).
 const double kSkipEps = 1e-6;
+// Affine views: rows walked in lockstep by one thread (independent walks overlap cache misses).
+const int kLanes = 8;
 // Perspective rows: the footprint radius changes along a row; its bound from the two ends is
 // widened by this factor (the radius varies as 1/w, monotonic along a row, plus the Jacobian's
 // change, a few percent for voxels far from the camera).
@@ -135,6 +138,47 @@ VoxelProjector VoxelGrid::projector(const Camera& camera, Size imageSize) const
     return p;
 }
 
+void quadrantDistance(const Mat& label, const Rect& roi, int sx, int sy, Mat& dist)
+{
+    CV_CheckTypeEQ(label.type(), CV_8UC1, "label image");
+    CV_Assert(dist.type() == CV_8SC1 && dist.size() == label.size());
+    CV_Assert((roi & Rect(Point(0, 0), label.size())) == roi);
+    if (roi.empty())
+        return;
+    const uchar kSat = 127;
+    const int w = roi.width;
+    const int xs = sx > 0 ? roi.x + roi.width - 1 : roi.x;
+    const int ys = sy > 0 ? roi.y + roi.height - 1 : roi.y;
+    // Two one-label distances, to the nearest outside pixel (dk) and to the nearest kept pixel
+    // (dout), in processing order t (t = 0 at the far corner's column), with a sentinel at t = -1
+    // and a sentinel row before the first: no source beyond the roi.
+    std::vector<uchar> buf(4 * (w + 1), kSat);
+    uchar* pk = &buf[0] + 1;
+    uchar* po = &buf[w + 1] + 1;
+    uchar* ck = &buf[2 * (w + 1)] + 1;
+    uchar* co = &buf[3 * (w + 1)] + 1;
+    for (int r = 0; r < roi.height; r++)
+    {
+        const int y = ys - sy * r;
+        const uchar* l = label.ptr<uchar>(y) + xs;
+        schar* d = dist.ptr<schar>(y) + xs;
+        const int step = -sx;
+        for (int t = 0; t < w; t++)
+        {
+            const bool kept = l[step * t] != 0;
+            const int mk = std::min(std::min((int)ck[t - 1], (int)pk[t]), (int)pk[t - 1]) + 1;
+            const int mo = std::min(std::min((int)co[t - 1], (int)po[t]), (int)po[t - 1]) + 1;
+            const uchar vk = kept ? (uchar)std::min(mk, (int)kSat) : (uchar)0;
+            const uchar vo = kept ? (uchar)0 : (uchar)std::min(mo, (int)kSat);
+            ck[t] = vk;
+            co[t] = vo;
+            d[step * t] = kept ? (schar)vk : (schar)(-(int)vo);
+        }
+        std::swap(pk, ck);
+        std::swap(po, co);
+    }
+}
+
 CarveView VoxelGrid::carveView(const Camera& camera, const Mat& keep) const
 {
     CV_CheckTypeEQ(keep.type(), CV_8UC1, "keep mask");
@@ -145,16 +189,91 @@ CarveView VoxelGrid::carveView(const Camera& camera, const Mat& keep) const
     v.pad = 4;
     Mat k01 = keep != 0;
     copyMakeBorder(k01, v.keep, v.pad, v.pad, v.pad, v.pad, BORDER_CONSTANT, Scalar(255));
+    const Rect all(Point(0, 0), v.keep.size());
+    // The distances are needed only where footprints fall: the grid's image bounds (not clipped
+    // to the image), in padded coordinates.
+    v.roi = all;
+    {
+        int x0 = INT_MAX, y0 = INT_MAX, x1 = INT_MIN, y1 = INT_MIN;
+        bool ok = true;
+        for (int c = 0; c < 8 && ok; c++)
+        {
+            int a0 = 0, a1 = 0, b0 = 0, b1 = 0;
+            double z = 0;
+            ok = v.proj.footprint(c & 1 ? dims[0] - 1 : 0, c & 2 ? dims[1] - 1 : 0,
+                                  c & 4 ? dims[2] - 1 : 0, a0, a1, b0, b1, z);
+            x0 = std::min(x0, a0 - 2);
+            y0 = std::min(y0, b0 - 2);
+            x1 = std::max(x1, a1 + 2);
+            y1 = std::max(y1, b1 + 2);
+        }
+        if (ok)
+            v.roi = Rect(Point(x0 + v.pad, y0 + v.pad), Point(x1 + v.pad + 1, y1 + v.pad + 1)) & all;
+    }
+    v.dist.create(v.keep.size(), CV_8SC1);
+    v.dist.setTo(Scalar(1));
+    if (v.roi.empty())
+        return v;
+    if (v.proj.affine)
+    {
+        // Every row steps by (M00, M10) per voxel: only the quadrant ahead matters.
+        v.quadrant = true;
+        v.sx = v.proj.M(0, 0) >= 0 ? 1 : -1;
+        v.sy = v.proj.M(1, 0) >= 0 ? 1 : -1;
+        v.rad = (int)std::floor(0.5 + std::max(v.proj.ruAffine, v.proj.rvAffine));
+        quadrantDistance(v.keep, v.roi, v.sx, v.sy, v.dist);
+        // Outside the roi: "kept, q unknown" (forces the exact test), no neighbour outside.
+        v.walk.create(v.keep.size(), CV_8UC2);
+        v.walk.setTo(Scalar(0, 0));
+        const int W = v.keep.cols, H = v.keep.rows;
+        for (int y = v.roi.y; y < v.roi.y + v.roi.height; y++)
+        {
+            const schar* d = v.dist.ptr<schar>(y);
+            const uchar* k = v.keep.ptr<uchar>(y);
+            const uchar* ku = y > 0 ? v.keep.ptr<uchar>(y - 1) : nullptr;
+            const uchar* kd = y + 1 < H ? v.keep.ptr<uchar>(y + 1) : nullptr;
+            const int qy = y - v.sy * v.rad;
+            const bool qyIn = qy >= v.roi.y && qy < v.roi.y + v.roi.height;
+            const schar* dq = qyIn ? v.dist.ptr<schar>(qy) : nullptr;
+            uchar* w = v.walk.ptr<uchar>(y);
+            for (int x = v.roi.x; x < v.roi.x + v.roi.width; x++)
+            {
+                if (!k[x])
+                {
+                    w[2 * x] = (uchar)d[x];
+                    w[2 * x + 1] = 0;
+                    continue;
+                }
+                const int qx = x - v.sx * v.rad;
+                int sq = 0;
+                if (dq && qx >= v.roi.x && qx < v.roi.x + v.roi.width)
+                    sq = std::max((int)dq[qx], 0);
+                w[2 * x] = (uchar)(schar)sq;
+                w[2 * x + 1] = 0;
+                if (sq > 2 * v.rad)
+                    continue;  // the walk skips here; no exact test needs the neighbours
+                // Neighbours off the padded image are unknown (kept).
+                auto out = [&](const uchar* r, int xx) {
+                    return r && xx >= 0 && xx < W && !r[xx];
+                };
+                const int nb = out(ku, x - 1) | out(ku, x) << 1 | out(ku, x + 1) << 2 |
+                               out(k, x - 1) << 3 | out(k, x + 1) << 4 |
+                               out(kd, x - 1) << 5 | out(kd, x) << 6 | out(kd, x + 1) << 7;
+                w[2 * x + 1] = (uchar)nb;
+            }
+        }
+        return v;
+    }
     // Signed, saturated distance in one byte per pixel (one cache line serves both the label and
     // the distance): +D where kept, -D outside; skips are capped at 127 pixels.
-    const Mat d16 = labelDistance(v.keep);
-    v.dist.create(v.keep.size(), CV_8SC1);
-    for (int y = 0; y < v.keep.rows; y++)
+    const Mat kr = v.keep(v.roi);
+    const Mat d16 = labelDistance(kr);
+    for (int y = 0; y < kr.rows; y++)
     {
         const ushort* d = d16.ptr<ushort>(y);
-        const uchar* k = v.keep.ptr<uchar>(y);
-        schar* o = v.dist.ptr<schar>(y);
-        for (int x = 0; x < v.keep.cols; x++)
+        const uchar* k = kr.ptr<uchar>(y);
+        schar* o = v.dist.ptr<schar>(y + v.roi.y) + v.roi.x;
+        for (int x = 0; x < kr.cols; x++)
         {
             const int c = std::min((int)d[x], 127);
             o[x] = (schar)(k[x] ? c : -c);
@@ -184,41 +303,62 @@ bool VoxelGrid::footprintKept(const CarveView& view, int i, int j, int k) const
 
 namespace {
 
-// Carves one voxel row (j, k) with one view. Walks the alive voxels, and uses the chessboard
-// distance of the pixel under the current voxel to skip every following voxel that provably has
-// the same outcome: moving the projected centre by delta (L-inf) moves its rounded pixel by at
-// most floor(delta) + 1, and footprints lie within `rad` of that pixel.
-void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* row)
+// VoxelGrid::footprintKept, inlined for the row walk.
+inline bool footprintKeptFast(const CarveView& view, int i, int j, int k)
+{
+    int x0, x1, y0, y1;
+    double z;
+    if (!view.proj.footprint(i, j, k, x0, x1, y0, y1, z))
+        return true;
+    const int W = view.keep.cols, H = view.keep.rows;
+    x0 = std::max(x0 + view.pad, 0);
+    x1 = std::min(x1 + view.pad, W - 1);
+    y0 = std::max(y0 + view.pad, 0);
+    y1 = std::min(y1 + view.pad, H - 1);
+    for (int y = y0; y <= y1; y++)
+    {
+        const uchar* r = view.keep.ptr<uchar>(y);
+        for (int x = x0; x <= x1; x++)
+            if (!r[x])
+                return false;
+    }
+    return true;
+}
+
+// Carves voxels lo..hi of one voxel row (j, k) with one view (perspective views; affine views
+// use AffineWalk). Walks the alive voxels, and uses the symmetric
+// chessboard distance of the pixel under the current voxel to skip every following voxel that
+// provably has the same outcome: moving the projected centre by delta (L-inf) moves its rounded
+// pixel by at most floor(delta) + 1, and footprints lie within `rad` of that pixel.
+void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* row, int lo, int hi)
 {
     const VoxelProjector& P = view.proj;
     const int nx = g.dims[0];
-    const Vec3d A(P.M(0, 1) * j + P.M(0, 2) * k + P.c[0], P.M(1, 1) * j + P.M(1, 2) * k + P.c[1],
-                  P.M(2, 1) * j + P.M(2, 2) * k + P.c[2]);
-    const Vec3d B(P.M(0, 0), P.M(1, 0), P.M(2, 0));
+    const double A0 = P.M(0, 1) * j + P.M(0, 2) * k + P.c[0];
+    const double A1 = P.M(1, 1) * j + P.M(1, 2) * k + P.c[1];
+    const double A2 = P.M(2, 1) * j + P.M(2, 2) * k + P.c[2];
+    const double B0 = P.M(0, 0), B1 = P.M(1, 0), B2 = P.M(2, 0);
     double step, rmax;
     if (P.affine)
     {
-        step = std::max(std::abs(B[0]), std::abs(B[1]));
+        step = std::max(std::abs(B0), std::abs(B1));
         rmax = std::max(P.ruAffine, P.rvAffine);
     }
     else
     {
-        const double w0 = A[2], w1 = A[2] + B[2] * (nx - 1);
+        const double w0 = A2, w1 = A2 + B2 * (nx - 1);
         const double wmin = std::min(w0, w1);
         if (!(wmin > 1e-12))
             return;  // part of the row is behind the camera: no evidence, keep
         // u(i) = (A0 + B0 i) / (A2 + B2 i): du/di = (B0 A2 - A0 B2) / w^2, largest at wmin.
-        step = std::max(std::abs(B[0] * A[2] - A[0] * B[2]),
-                        std::abs(B[1] * A[2] - A[1] * B[2])) / (wmin * wmin);
+        step = std::max(std::abs(B0 * A2 - A0 * B2), std::abs(B1 * A2 - A1 * B2)) /
+               (wmin * wmin);
         double r = 0;
         for (int e = 0; e < 2; e++)
         {
-            int x0, x1, y0, y1;
-            double z;
             const int i = e == 0 ? 0 : nx - 1;
-            const double w = A[2] + B[2] * i;
-            const double u = (A[0] + B[0] * i) / w, v = (A[1] + B[1] * i) / w;
-            (void)x0; (void)x1; (void)y0; (void)y1; (void)z;
+            const double w = A2 + B2 * i;
+            const double u = (A0 + B0 * i) / w, v = (A1 + B1 * i) / w;
             const double ru = 0.5 / w * (std::abs(P.M(0, 0) - u * P.M(2, 0)) +
                                          std::abs(P.M(0, 1) - u * P.M(2, 1)) +
                                          std::abs(P.M(0, 2) - u * P.M(2, 2)));
@@ -230,24 +370,28 @@ void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* ro
         rmax = r * kPerspectiveRadiusMargin;
     }
     step = std::max(step, 1e-9);
+    const double inv = 1.0 / step;
     const int rad = (int)std::floor(0.5 + rmax);
     const int pad = view.pad;
     const int W = view.keep.cols, H = view.keep.rows;
-    int i = 0;
-    while (i < nx)
+    const schar* dist = view.dist.ptr<schar>();
+    const size_t dstep = view.dist.step[0];
+    const int end = hi + 1;
+    int i = lo;
+    while (i < end)
     {
         if (!row[i])
         {
-            const void* nxt = std::memchr(row + i, 1, (size_t)(nx - i));
+            const void* nxt = std::memchr(row + i, 1, (size_t)(end - i));
             if (!nxt)
                 break;
             i = (int)((const uchar*)nxt - row);
             continue;
         }
-        double u = A[0] + B[0] * i, v = A[1] + B[1] * i;
+        double u = A0 + B0 * i, v = A1 + B1 * i;
         if (!P.affine)
         {
-            const double iw = 1.0 / (A[2] + B[2] * i);
+            const double iw = 1.0 / (A2 + B2 * i);
             u *= iw;
             v *= iw;
         }
@@ -257,35 +401,201 @@ void carveRow(const VoxelGrid& g, const CarveView& view, int j, int k, uchar* ro
             // Off the padded image: unknown, kept; skip while the footprint stays off the image
             // or in the keep border.
             const int dOut = std::max(std::max(-px, px - (W - 1)), std::max(-py, py - (H - 1)));
-            const int n = (int)std::floor((dOut + pad - 1 - rad - kSkipEps) / step);
+            const int n = (int)((dOut + pad - 1 - rad - kSkipEps) * inv);
             i += std::max(n, 0) + 1;
             continue;
         }
         // One signed byte per pixel: +D in the keep region, -D outside (see CarveView).
-        const int sd = view.dist.at<schar>(py, px);
-        const int D = std::abs(sd);
+        const int sd = dist[(size_t)py * dstep + px];
         if (sd > 0)
         {
-            if (D > rad)
+            if (sd > rad)
             {
-                const int n = (int)std::floor((D - 1 - rad - kSkipEps) / step);
+                const int n = (int)((sd - 1 - rad - kSkipEps) * inv);
                 i += std::max(n, 0) + 1;
             }
             else
             {
-                if (!g.footprintKept(view, i, j, k))
+                if (!footprintKeptFast(view, i, j, k))
                     row[i] = 0;
                 i++;
             }
         }
         else
         {
-            const int n = std::max((int)std::floor((D - 1 - kSkipEps) / step), 0);
-            const int end = std::min(nx, i + n + 1);
-            std::memset(row + i, 0, (size_t)(end - i));
-            i = end;
+            const int n = std::max((int)((-sd - 1 - kSkipEps) * inv), 0);
+            const int e = std::min(end, i + n + 1);
+            std::memset(row + i, 0, (size_t)(e - i));
+            i = e;
         }
     }
+}
+
+// Affine (quadrant) views: the row walk with everything that does not depend on the row
+// precomputed, and the skip lengths as integer tables of the map value. Same rules as carveRow's
+// quadrant branch.
+class AffineWalk
+{
+public:
+    AffineWalk(const CarveView& view) : view_(view)
+    {
+        const VoxelProjector& P = view.proj;
+        B0_ = P.M(0, 0);
+        B1_ = P.M(1, 0);
+        const double inv = 1.0 / std::max(std::max(std::abs(B0_), std::abs(B1_)), 1e-9);
+        rad_ = view.rad;
+        pad_ = view.pad;
+        W_ = view.keep.cols;
+        H_ = view.keep.rows;
+        rx0_ = view.roi.x;
+        ry0_ = view.roi.y;
+        rw_ = (unsigned)view.roi.width;
+        rh_ = (unsigned)view.roi.height;
+        walk_ = view.walk.ptr<uchar>();
+        wstep_ = view.walk.step[0];
+        inv_ = inv;
+        for (int d = 0; d < 128; d++)
+        {
+            // Outside: the next n voxels are outside too; kept (d > 2 rad): the next n are kept.
+            skipOut_[d] = 1 + std::max((int)std::floor((d - 1 - kSkipEps) * inv), 0);
+            skipIn_[d] = 1 + std::max((int)std::floor((d - 1 - 2 * rad_ - kSkipEps) * inv), 0);
+        }
+    }
+
+    //! One row's walk: voxels [i, end) of `row` are left.
+    struct State
+    {
+        uchar* row;
+        int j, k, i, end;
+        double A0, A1;
+    };
+
+    void begin(State& st, int j, int k, uchar* row, int lo, int hi) const
+    {
+        const VoxelProjector& P = view_.proj;
+        st.row = row;
+        st.j = j;
+        st.k = k;
+        st.i = lo;
+        st.end = hi + 1;
+        st.A0 = P.M(0, 1) * j + P.M(0, 2) * k + P.c[0];
+        st.A1 = P.M(1, 1) * j + P.M(1, 2) * k + P.c[1];
+    }
+
+    //! Advances the walk by one decision; false when the row is done.
+    inline bool step(State& st) const
+    {
+        uchar* row = st.row;
+        const int j = st.j, k = st.k, end = st.end;
+        const double A0 = st.A0, A1 = st.A1;
+        int i = st.i;
+        do  // one decision; `continue` ends it
+        {
+            if (i >= end)
+                break;
+            if (!row[i])
+            {
+                const void* nxt = std::memchr(row + i, 1, (size_t)(end - i));
+                i = nxt ? (int)((const uchar*)nxt - row) : end;
+                continue;
+            }
+            const int px = cvRound(A0 + B0_ * i) + pad_, py = cvRound(A1 + B1_ * i) + pad_;
+            if ((unsigned)(px - rx0_) >= rw_ || (unsigned)(py - ry0_) >= rh_)
+            {
+                if (px < 0 || py < 0 || px >= W_ || py >= H_)
+                {
+                    // Off the padded image: unknown, kept (as carveRow).
+                    const int dOut = std::max(std::max(-px, px - (W_ - 1)),
+                                              std::max(-py, py - (H_ - 1)));
+                    const int n = (int)std::floor((dOut + pad_ - 1 - rad_ - kSkipEps) * inv_);
+                    i += std::max(n, 0) + 1;
+                }
+                else
+                {
+                    // Not reached (footprints lie in the roi), but stay exact if it were.
+                    if (!footprintKeptFast(view_, i, j, k))
+                        row[i] = 0;
+                    i++;
+                }
+                continue;
+            }
+            const uchar* wp = walk_ + (size_t)py * wstep_ + 2 * px;
+            const int sv = (schar)wp[0];
+            if (sv < 0)
+            {
+                const int e = std::min(end, i + skipOut_[-sv]);
+                if (e - i <= 8)
+                    for (; i < e; i++)
+                        row[i] = 0;
+                else
+                {
+                    std::memset(row + i, 0, (size_t)(e - i));
+                    i = e;
+                }
+                continue;
+            }
+            if (sv > 2 * rad_)
+            {
+                i += skipIn_[sv];
+                continue;
+            }
+            if (!exactKept(wp, px, py, i, j, k))
+                row[i] = 0;
+            i++;
+        } while (false);
+        st.i = i;
+        return i < end;
+    }
+
+private:
+    inline bool exactKept(const uchar* wp, int px, int py, int i, int j, int k) const
+    {
+        // px, py are the footprint's own rounded centre (same arithmetic), and footprints lie
+        // within rad of it: with no outside neighbour there is nothing to test.
+        if (rad_ <= 1 && wp[1] == 0)
+            return true;
+        int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+        double z = 0;
+        view_.proj.footprint(i, j, k, x0, x1, y0, y1, z);
+        x0 -= px - pad_;
+        x1 -= px - pad_;
+        y0 -= py - pad_;
+        y1 -= py - pad_;
+        if (x0 >= -1 && x1 <= 1 && y0 >= -1 && y1 <= 1)
+        {
+            int m9 = 0;
+            for (int yy = y0; yy <= y1; yy++)
+                for (int xx = x0; xx <= x1; xx++)
+                    m9 |= 1 << ((yy + 1) * 3 + xx + 1);
+            const int m8 = (m9 & 15) | ((m9 >> 5) << 4);
+            return (wp[1] & m8) == 0;  // the centre is kept (sv >= 0)
+        }
+        return footprintKeptFast(view_, i, j, k);
+    }
+
+    const CarveView& view_;
+    double B0_, B1_, inv_;
+    int rad_, pad_, W_, H_, rx0_, ry0_;
+    unsigned rw_, rh_;
+    const uchar* walk_;
+    size_t wstep_;
+    int skipOut_[128], skipIn_[128];
+};
+
+// Last alive voxel of row[lo..hi], or lo - 1 when none.
+inline int lastAlive(const uchar* row, int lo, int hi)
+{
+    while (hi >= lo + 7)
+    {
+        uint64_t w;
+        std::memcpy(&w, row + hi - 7, 8);
+        if (w)
+            break;
+        hi -= 8;
+    }
+    while (hi >= lo && !row[hi])
+        hi--;
+    return hi;
 }
 
 } // namespace
@@ -294,14 +604,91 @@ void VoxelGrid::carve(const std::vector<CarveView>& views)
 {
     if (views.empty() || data.empty())
         return;
-    const int ny = dims[1];
+    const int nx = dims[0], ny = dims[1];
+    // The views that carve most go first, so that most rows die (or shrink) early: the fraction of
+    // outside pixels in the grid's image bounds. The order does not change the result (carving is
+    // an intersection).
+    std::vector<std::pair<double, int> > strength(views.size());
+    for (size_t q = 0; q < views.size(); q++)
+    {
+        const CarveView& v = views[q];
+        const Rect roi = (imageBounds(v.proj) + Point(v.pad, v.pad)) &
+                         Rect(Point(0, 0), v.keep.size());
+        const double out = roi.area() > 0 ? 1.0 - countNonZero(v.keep(roi)) / (double)roi.area()
+                                          : 0.0;
+        strength[q] = std::make_pair(-out, (int)q);
+    }
+    std::sort(strength.begin(), strength.end());
+    // Per z slice, view by view (the view's maps stay in cache over the slice), each row only over
+    // its alive span; a row that dies needs no further view. Rows are independent, so the result
+    // does not depend on the partition into threads.
+    std::vector<std::unique_ptr<AffineWalk> > affine(views.size());
+    for (size_t q = 0; q < views.size(); q++)
+        if (views[q].quadrant)
+            affine[q].reset(new AffineWalk(views[q]));
     parallel_for_(Range(0, dims[2]), [&](const Range& r) {
-        // View-major within a slice: consecutive rows project to neighbouring image rows, so the
-        // view's label and distance images stay in cache.
+        std::vector<int> lo(ny), hi(ny);
         for (int k = r.start; k < r.end; k++)
-            for (const CarveView& v : views)
+        {
+            for (int j = 0; j < ny; j++)
+            {
+                const uchar* row = &data[index(0, j, k)];
+                const void* first = std::memchr(row, 1, (size_t)nx);
+                lo[j] = first ? (int)((const uchar*)first - row) : nx;
+                hi[j] = first ? lastAlive(row, lo[j], nx - 1) : -1;
+            }
+            for (const auto& s : strength)
+            {
+                const CarveView& view = views[s.second];
+                const AffineWalk* aw = affine[s.second].get();
+                bool any = false;
+                auto update = [&](int jj) {
+                    const uchar* rr = &data[index(0, jj, k)];
+                    const void* f = std::memchr(rr + lo[jj], 1, (size_t)(hi[jj] - lo[jj] + 1));
+                    if (!f)
+                    {
+                        lo[jj] = nx;
+                        hi[jj] = -1;
+                        return;
+                    }
+                    lo[jj] = (int)((const uchar*)f - rr);
+                    hi[jj] = lastAlive(rr, lo[jj], hi[jj]);
+                    any = true;
+                };
                 for (int j = 0; j < ny; j++)
-                    carveRow(*this, v, j, k, &data[index(0, j, k)]);
+                {
+                    if (lo[j] > hi[j])
+                        continue;
+                    if (!aw)
+                    {
+                        carveRow(*this, view, j, k, &data[index(0, j, k)], lo[j], hi[j]);
+                        update(j);
+                        continue;
+                    }
+                    // Several rows walked in lockstep: their cache misses overlap.
+                    AffineWalk::State st[kLanes];
+                    int rows[kLanes], n = 0;
+                    for (int jj = j; jj < ny && n < kLanes; jj++)
+                        if (lo[jj] <= hi[jj])
+                        {
+                            aw->begin(st[n], jj, k, &data[index(0, jj, k)], lo[jj], hi[jj]);
+                            rows[n++] = jj;
+                        }
+                    bool more = true;
+                    while (more)
+                    {
+                        more = false;
+                        for (int l = 0; l < n; l++)
+                            more |= aw->step(st[l]);
+                    }
+                    for (int l = 0; l < n; l++)
+                        update(rows[l]);
+                    j = rows[n - 1];
+                }
+                if (!any)
+                    break;
+            }
+        }
     });
 }
 
@@ -463,6 +850,44 @@ void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* f
             if (proj.viewDir[a] < 0) frontMask |= (uchar)(1 << (2 * a + 1));
         }
     const bool cull = frontOnly && faces;
+    if (proj.affine && !zmax)
+    {
+        // The renderer's path: VoxelProjector::footprint's arithmetic term for term (so key
+        // frames stay exact), with the row part computed once per voxel row (voxels come sorted).
+        const double ru = proj.ruAffine, rv = proj.rvAffine;
+        const Matx33d& M = proj.M;
+        uint32_t lastRow = ~0u;
+        double a0 = 0, a1 = 0, az = 0;
+        for (size_t q = 0; q < n; q++)
+        {
+            if (cull && !(faces[q] & frontMask))
+                continue;
+            const uint32_t p = ijk[q];
+            const int i = (int)(p & 1023u);
+            if ((p >> 10) != lastRow)
+            {
+                lastRow = p >> 10;
+                const int j = (int)(lastRow & 1023u), k = (int)(lastRow >> 10);
+                a0 = M(0, 1) * j + M(0, 2) * k + proj.c[0];
+                a1 = M(1, 1) * j + M(1, 2) * k + proj.c[1];
+                az = proj.Z[1] * j + proj.Z[2] * k + proj.z0;
+            }
+            const double u = M(0, 0) * i + a0, v = M(1, 0) * i + a1;
+            const int pu = cvRound(u), pv = cvRound(v);
+            const int x0 = std::max(std::min(cvCeil(u - ru), pu), X0);
+            const int x1 = std::min(std::max(cvFloor(u + ru), pu), X1);
+            const int y0 = std::max(std::min(cvCeil(v - rv), pv), Y0);
+            const int y1 = std::min(std::max(cvFloor(v + rv), pv), Y1);
+            const float z = (float)(proj.Z[0] * i + az);
+            for (int y = y0; y <= y1; y++)
+            {
+                float* zr = zmin.ptr<float>(y - offset.y) - offset.x;
+                for (int x = x0; x <= x1; x++)
+                    zr[x] = std::min(zr[x], z);
+            }
+        }
+        return;
+    }
     for (size_t q = 0; q < n; q++)
     {
         int i, j, k;
@@ -548,7 +973,9 @@ void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
     parallel_for_(Range(0, chunks), [&](const Range& r) {
         for (int c = r.start; c < r.end; c++)
         {
-            Mat b(roi.size(), CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+            // Chunk 0 splats straight into the output (already +inf), the others into buffers.
+            Mat b = c == 0 ? zmin(roi)
+                           : Mat(roi.size(), CV_32F, Scalar(std::numeric_limits<float>::infinity()));
             for (const VoxelList& l : lists)
             {
                 const size_t a = l.n * c / chunks, e = l.n * (c + 1) / chunks;
@@ -559,7 +986,6 @@ void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
         }
     });
     Mat dst = zmin(roi);
-    bufs[0].copyTo(dst);
     for (int c = 1; c < chunks; c++)
         cv::min(dst, bufs[c], dst);
 }

@@ -66,8 +66,10 @@ struct VoxelProjector
     inline bool footprint(double i, double j, double k, int& x0, int& x1, int& y0, int& y1,
                           double& depth) const
     {
-        const double hx = M(0, 0) * i + M(0, 1) * j + M(0, 2) * k + c[0];
-        const double hy = M(1, 0) * i + M(1, 1) * j + M(1, 2) * k + c[1];
+        // Row part first (M(:,1) j + M(:,2) k + c, then + M(:,0) i): the row walk and the
+        // renderer evaluate it once per voxel row and get the same bits.
+        const double hx = M(0, 0) * i + (M(0, 1) * j + M(0, 2) * k + c[0]);
+        const double hy = M(1, 0) * i + (M(1, 1) * j + M(1, 2) * k + c[1]);
         double u, v, ru, rv;
         if (affine)
         {
@@ -90,11 +92,11 @@ struct VoxelProjector
                              std::abs(M(1, 2) - v * M(2, 2)));
         }
         const int pu = cvRound(u), pv = cvRound(v);
-        x0 = std::min((int)std::ceil(u - ru), pu);
-        x1 = std::max((int)std::floor(u + ru), pu);
-        y0 = std::min((int)std::ceil(v - rv), pv);
-        y1 = std::max((int)std::floor(v + rv), pv);
-        depth = Z[0] * i + Z[1] * j + Z[2] * k + z0;
+        x0 = std::min(cvCeil(u - ru), pu);
+        x1 = std::max(cvFloor(u + ru), pu);
+        y0 = std::min(cvCeil(v - rv), pv);
+        y1 = std::max(cvFloor(v + rv), pv);
+        depth = Z[0] * i + (Z[1] * j + Z[2] * k + z0);
         return true;
     }
 };
@@ -107,9 +109,27 @@ struct CarveView
     VoxelProjector proj;
     Mat keep;   //!< CV_8U, padded
     Mat dist;   //!< CV_8S, padded: +D kept, -D outside, D the chessboard distance to the other
-                //!< label saturated at 127
+                //!< label saturated at 127 (only over `roi`; +1 elsewhere, which forces exact tests)
     int pad = 0;
+    Rect roi;   //!< padded coordinates: every voxel footprint of the grid lies in it
+    /** Affine views: voxel rows all move the same way in the image, (sx, sy) the signs of the
+    step. `dist` then counts only the other label's pixels in the quadrant ahead
+    {(x' - x) sx >= 0, (y' - y) sy >= 0}, which the rest of the row can reach (quadrantDistance). */
+    bool quadrant = false;
+    int sx = 1, sy = 1;
+    int rad = 0;  //!< quadrant views: footprints lie within rad pixels of the centre's pixel
+    /** Quadrant views: per pixel of `roi` two bytes, what the row walk needs from one cache line.
+    Byte 0 (signed): outside pixels -D, D the quadrant distance to a kept pixel; kept pixels the
+    quadrant distance of q = (x - sx rad, y - sy rad) to an outside pixel (0 when q is outside).
+    Byte 1: which of the 8 neighbours are outside (bit order row by row, the centre left out). */
+    Mat walk;
 };
+
+/** @brief Chessboard distance of every pixel of `roi` to the nearest pixel of the other label in
+the quadrant {(x' - x) sx >= 0, (y' - y) sy >= 0} of `roi`, saturated at 127 and signed (+ where
+`label` is nonzero): one raster pass from the quadrant's far corner. Exact: a chessboard path
+between two pixels of a rectangle can stay in it and move monotonically. */
+CV_EXPORTS void quadrantDistance(const Mat& label, const Rect& roi, int sx, int sy, Mat& dist);
 
 //! Chessboard distance of every pixel to the nearest pixel of the other label (CV_16U).
 CV_EXPORTS Mat labelDistance(const Mat& label);

@@ -42,6 +42,8 @@ struct CV_EXPORTS CompositeOptions
     //! Light frame (Compositor::Params::lightRotation); default: from estimateGround(rec).
     bool lightFromGround = true;
     ProgressCallback progress; //!< called after every frame
+    //! Name of the reconstruction in error messages (its file, when it comes from one).
+    String reconstructionName = "reconstruction";
 };
 
 /** @brief Composites frames [firstFrame, endFrame) of a sequence and writes the result.

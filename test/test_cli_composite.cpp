@@ -1,0 +1,356 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// Bad inputs of `augocc composite` and `augocc run`, through the built binary: each must exit 2
+// with one message naming the file or flag and the problem, and leave no output behind (not even
+// a partial video or PNG under a temporary name).
+
+#include "test_precomp.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+namespace fs = std::filesystem;
+
+// A small valid data set: a 6-frame 160x120 synthetic sequence as an MJPG AVI and as PNGs, its
+// true reconstruction, clones built from it, key-frame masks and the demo's scene file.
+struct CliData
+{
+    String dir, video, frames, rec, clones, scene, masks;
+    int frameCount = 0;
+    Size size;
+    bool ok = false;
+};
+
+const int kFrames = 6;
+
+void writeAvi(const String& path, const std::vector<Mat>& frames, int count)
+{
+    VideoWriter w(path, CAP_FFMPEG, VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
+                  frames[0].size(), true);
+    ASSERT_TRUE(w.isOpened()) << path;
+    for (int i = 0; i < count; i++)
+        w.write(frames[i]);
+}
+
+void writeText(const String& path, const String& text)
+{
+    std::ofstream f(path, std::ios::binary);
+    f << text;
+}
+
+const CliData& cliData()
+{
+    static CliData d;
+    if (d.ok)
+        return d;
+    d.dir = (fs::temp_directory_path() / "augocc_test" / "Augocc_CliComposite").string();
+    fs::remove_all(d.dir);
+    fs::create_directories(d.dir);
+    SceneSynthesizer::Params sp;
+    sp.frames = kFrames;
+    sp.imageSize = Size(160, 120);
+    sp.numKeyFrames = 2;
+    SyntheticScene scene;
+    SceneSynthesizer::create(sp)->synthesize(scene);
+    d.size = sp.imageSize;
+    d.frameCount = kFrames;
+    const fs::path dir(d.dir);
+    d.video = (dir / "video.avi").string();
+    writeAvi(d.video, scene.frames, kFrames);
+    d.frames = (dir / "frames").string();
+    fs::create_directories(d.frames);
+    for (int f = 0; f < kFrames; f++)
+        imwrite((fs::path(d.frames) / cv::format("%04d.png", f)).string(), scene.frames[f]);
+    d.rec = (dir / "reconstruction.yml").string();
+    writeReconstruction(d.rec, scene.groundTruth);
+    d.masks = (dir / "masks").string();
+    writeMasks(d.masks, scene.keyFrameMasks);
+    d.clones = (dir / "clones.yml.gz").string();
+    CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks)->save(d.clones);
+    d.scene = (dir / "scene.yml").string();
+    writeScene(d.scene, demoVirtualScene(d.scene));
+    d.ok = true;
+    return d;
+}
+
+String q(const String& s)
+{
+    return "'" + s + "'";
+}
+
+// Every entry of a folder, recursively (hidden temporaries included).
+std::vector<String> listAll(const String& dir)
+{
+    std::vector<String> out;
+    if (!fs::exists(dir))
+        return out;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        out.push_back(e.path().string());
+    return out;
+}
+
+String joined(const std::vector<String>& v)
+{
+    String s;
+    for (const String& x : v)
+        s += x + " ";
+    return s;
+}
+
+// Runs the command, expects exit 2, one message that contains every `needles` entry, and an
+// empty output folder.
+void expectBadInput(const String& args, const std::vector<String>& needles, const String& outDir)
+{
+    String output;
+    const int status = runCommand(augoccBinary() + " " + args, &output);
+    EXPECT_EQ(2, status) << args << "\n" << output;
+    for (const String& n : needles)
+        EXPECT_NE(String::npos, output.find(n)) << "message should name '" << n << "': "
+                                                << output;
+    const std::vector<String> left = listAll(outDir);
+    EXPECT_TRUE(left.empty()) << "output left behind: " << joined(left);
+}
+
+class Augocc_CliComposite : public testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        const CliData& d = cliData();
+        ASSERT_TRUE(d.ok);
+        out_ = tempDir("out");
+    }
+
+    // `augocc composite` with the valid data set, some of it replaced.
+    String compositeArgs(const String& input, const String& rec, const String& scene,
+                         const String& out, const String& extra = "") const
+    {
+        const CliData& d = cliData();
+        return "--quiet composite --input " + q(input) + " --reconstruction " + q(rec) +
+               " --clones " + q(d.clones) + " --scene " + q(scene) + " --out " + q(out) + " " +
+               extra;
+    }
+
+    String out_;
+};
+
+TEST_F(Augocc_CliComposite, valid_inputs_write_the_outputs)
+{
+    // The data set itself is good: the bad cases below fail for their own reason.
+    const CliData& d = cliData();
+    const String mp4 = (fs::path(out_) / "out.mp4").string();
+    String output;
+    ASSERT_EQ(0, runCommand(augoccBinary() + " " + compositeArgs(d.video, d.rec, d.scene, mp4,
+                            "--frames 1:4 --hard-edges"), &output)) << output;
+    VideoCapture cap(mp4);
+    ASSERT_TRUE(cap.isOpened());
+    EXPECT_EQ(3, (int)cap.get(CAP_PROP_FRAME_COUNT));
+    const String pngs = (fs::path(out_) / "pngs").string();
+    ASSERT_EQ(0, runCommand(augoccBinary() + " " + compositeArgs(d.frames, d.rec, d.scene, pngs,
+                            "--frames 4:"), &output)) << output;
+    EXPECT_TRUE(fs::exists(fs::path(pngs) / "0004.png"));
+    EXPECT_TRUE(fs::exists(fs::path(pngs) / "0005.png"));
+    EXPECT_EQ(4u, listAll(out_).size()) << joined(listAll(out_));  // out.mp4, pngs, 2 PNGs
+}
+
+TEST_F(Augocc_CliComposite, bad_input_missing_video)
+{
+    const CliData& d = cliData();
+    const String missing = (fs::path(out_).parent_path() / "no_such_video.mp4").string();
+    expectBadInput(compositeArgs(missing, d.rec, d.scene, out_ + "/out.mp4"),
+                   {"no_such_video.mp4"}, out_);
+}
+
+TEST_F(Augocc_CliComposite, bad_input_corrupt_video)
+{
+    const CliData& d = cliData();
+    const String bad = tempDir("in") + "/corrupt.mp4";
+    writeText(bad, String(4096, '\x5a'));
+    expectBadInput(compositeArgs(bad, d.rec, d.scene, out_ + "/out.mp4"), {"corrupt.mp4"}, out_);
+    expectBadInput(compositeArgs(bad, d.rec, d.scene, out_ + "/pngs"), {"corrupt.mp4"}, out_);
+}
+
+TEST_F(Augocc_CliComposite, bad_input_video_cut_short)
+{
+    // The last frames are cut off the file: the first frames decode, composited frames are
+    // already written (under a temporary name) when the input fails.
+    const CliData& d = cliData();
+    const String cut = tempDir("in") + "/cut.avi";
+    {
+        std::ifstream in(d.video, std::ios::binary);
+        const String all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        writeText(cut, all.substr(0, all.size() * 2 / 3));
+    }
+    // Folders made for the output go too.
+    for (const char* name : {"out.mp4", "pngs", "new/sub/out.mp4", "new/pngs"})
+        expectBadInput(compositeArgs(cut, d.rec, d.scene, out_ + "/" + name), {"cut.avi"},
+                       out_);
+}
+
+TEST_F(Augocc_CliComposite, bad_input_mesh_does_not_parse)
+{
+    const CliData& d = cliData();
+    const String in = tempDir("in");
+    writeText(in + "/broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7 9\nthis is not an OBJ file\n");
+    writeText(in + "/scene.yml", "%YAML:1.0\n---\nobjects:\n  - { name: statue, mesh: "
+              "broken.obj, position: [0, 0, 0] }\n");
+    expectBadInput(compositeArgs(d.video, d.rec, in + "/scene.yml", out_ + "/out.mp4"),
+                   {"broken.obj"}, out_);
+}
+
+TEST_F(Augocc_CliComposite, bad_input_scene_unknown_key)
+{
+    const CliData& d = cliData();
+    const String in = tempDir("in");
+    writeText(in + "/scene.yml", "%YAML:1.0\n---\nobjects:\n  - { name: dome, shape: dome, "
+              "positon: [0, 0, 0] }\n");
+    expectBadInput(compositeArgs(d.video, d.rec, in + "/scene.yml", out_ + "/out.mp4"),
+                   {"scene.yml", "positon"}, out_);
+}
+
+TEST_F(Augocc_CliComposite, bad_input_frames_out_of_range)
+{
+    const CliData& d = cliData();
+    for (const char* range : {"4:99", "6:", "3:2", "a:b", "-1:3", "2:2"})
+        expectBadInput(compositeArgs(d.video, d.rec, d.scene, out_ + "/out.mp4",
+                                     String("--frames ") + range),
+                       {"frame"}, out_);
+}
+
+TEST_F(Augocc_CliComposite, bad_input_reconstruction_does_not_match_video)
+{
+    const CliData& d = cliData();
+    const String in = tempDir("in");
+    const Reconstruction rec = readReconstruction(d.rec);
+    // Fewer frames in the video than cameras in the reconstruction.
+    {
+        std::vector<Mat> frames;
+        Ptr<FrameSource> src = FrameSource::open(d.frames);
+        Mat f;
+        while (src->read(f))
+            frames.push_back(f.clone());
+        const String shortVideo = in + "/short.avi";
+        writeAvi(shortVideo, frames, kFrames - 2);
+        expectBadInput(compositeArgs(shortVideo, d.rec, d.scene, out_ + "/out.mp4"),
+                       {"short.avi", "reconstruction"}, out_);
+    }
+    // Another image size.
+    {
+        Reconstruction big = rec;
+        big.imageSize = Size(2 * rec.imageSize.width, 2 * rec.imageSize.height);
+        const String p = in + "/big.yml";
+        writeReconstruction(p, big);
+        expectBadInput(compositeArgs(d.video, p, d.scene, out_ + "/out.mp4"), {"big.yml"},
+                       out_);
+    }
+    // A frame without a camera.
+    {
+        Reconstruction gap = rec;
+        gap.cameras.erase(gap.cameras.begin() + 2);
+        const String p = in + "/gap.yml";
+        writeReconstruction(p, gap);
+        expectBadInput(compositeArgs(d.video, p, d.scene, out_ + "/out.mp4"),
+                       {"gap.yml", "frame 2"}, out_);
+    }
+}
+
+TEST_F(Augocc_CliComposite, bad_input_optional_outputs_left_clean)
+{
+    // The failure comes after the first frames: mattes, depth and layer folders must go too.
+    const CliData& d = cliData();
+    const String cut = tempDir("in") + "/cut.avi";
+    {
+        std::ifstream in(d.video, std::ios::binary);
+        const String all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        writeText(cut, all.substr(0, all.size() * 2 / 3));
+    }
+    expectBadInput(compositeArgs(cut, d.rec, d.scene, out_ + "/out.mp4",
+                                 "--mattes " + q(out_ + "/mattes") + " --depth " +
+                                     q(out_ + "/depth") + " --virtual-layer " +
+                                     q(out_ + "/layer")),
+                   {"cut.avi"}, out_);
+}
+
+// `augocc run`: the bad inputs are found before any work, and --out-dir stays empty.
+class Augocc_CliRun : public Augocc_CliComposite
+{
+protected:
+    String runArgs(const String& input, const String& masks, const String& scene) const
+    {
+        return "--quiet run --input " + q(input) + " --masks " + q(masks) +
+               (scene.empty() ? String() : " --scene " + q(scene)) + " --out-dir " +
+               q(out_ + "/run");
+    }
+};
+
+TEST_F(Augocc_CliRun, bad_input_missing_or_corrupt_video)
+{
+    const CliData& d = cliData();
+    const String in = tempDir("in");
+    expectBadInput(runArgs(in + "/no_such_video.mp4", d.masks, d.scene), {"no_such_video.mp4"},
+                   out_);
+    writeText(in + "/corrupt.mp4", String(4096, '\x5a'));
+    expectBadInput(runArgs(in + "/corrupt.mp4", d.masks, d.scene), {"corrupt.mp4"}, out_);
+}
+
+TEST_F(Augocc_CliRun, bad_input_video_cut_short)
+{
+    // Found only while tracking: the output folder made for the run goes again.
+    const CliData& d = cliData();
+    const String cut = tempDir("in") + "/cut.avi";
+    {
+        std::ifstream in(d.video, std::ios::binary);
+        const String all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        writeText(cut, all.substr(0, all.size() * 2 / 3));
+    }
+    expectBadInput(runArgs(cut, d.masks, d.scene), {"cut.avi"}, out_);
+}
+
+TEST_F(Augocc_CliRun, bad_input_mesh_and_scene)
+{
+    const CliData& d = cliData();
+    const String in = tempDir("in");
+    writeText(in + "/broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7 9\nthis is not an OBJ file\n");
+    writeText(in + "/mesh.yml", "%YAML:1.0\n---\nobjects:\n  - { name: statue, mesh: "
+              "broken.obj, position: [0, 0, 0] }\n");
+    expectBadInput(runArgs(d.video, d.masks, in + "/mesh.yml"), {"broken.obj"}, out_);
+    writeText(in + "/key.yml", "%YAML:1.0\n---\nobjects:\n  - { name: dome, shape: dome, "
+              "behind: building, colour: red }\n");
+    expectBadInput(runArgs(d.video, d.masks, in + "/key.yml"), {"key.yml", "colour"}, out_);
+}
+
+TEST_F(Augocc_CliRun, bad_input_masks_do_not_match_video)
+{
+    // Masks of another size than the frames: the masks belong to another video.
+    const CliData& d = cliData();
+    const String masks = tempDir("masks");
+    const ObjectMasks m = readMasks(d.masks, d.size);
+    ObjectMasks big;
+    for (const auto& o : m)
+        for (const auto& f : o.second)
+        {
+            Mat up;
+            cv::resize(f.second, up, Size(), 2, 2, INTER_NEAREST);
+            big[o.first][f.first] = up;
+        }
+    writeMasks(masks, big);
+    expectBadInput(runArgs(d.video, masks, d.scene), {"masks"}, out_);
+    // Masks for frames the video does not have.
+    const String late = tempDir("late");
+    ObjectMasks shifted;
+    for (const auto& o : m)
+        for (const auto& f : o.second)
+            shifted[o.first][f.first + kFrames] = f.second;
+    writeMasks(late, shifted);
+    expectBadInput(runArgs(d.video, late, d.scene), {"late", "video.avi"}, out_);
+}
+
+} // namespace
+} // namespace opencv_test
