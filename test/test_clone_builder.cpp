@@ -664,10 +664,10 @@ SynthFigures measureSynth(const CloneSet& clones, const SyntheticScene& s, const
 // count as "hidden" for the occlusion target (mean IoU 0.97 instead of 0.98).
 const double kHiddenObjectFraction = 0.02;
 // Hidden objects, mean IoU with the WHOLE true silhouette (as if alone) in non-key frames: the issue
-// asks 0.97, measured 0.914-0.972 (lblock 0.972 / 0.958, tower 0.914 / 0.959, orthographic /
-// perspective) since unseen components are dropped (0.846 for the perspective tower before). A
-// regression bound, not the target.
-const double kHiddenWholeMeanIoU = 0.9;
+// asks 0.97; measured since voxels no key frame shows are dropped: lblock 0.972 / 0.979, tower
+// 0.959 / 0.959 (orthographic / perspective; the tower's cap overhang is a visual-hull limit,
+// 0.914 / 0.846 before). A regression bound 0.01 under the worst, not the target.
+const double kHiddenWholeMeanIoU = 0.95;
 
 typedef testing::TestWithParam<int> Augocc_CloneBuilder_Synth;
 

@@ -607,7 +607,7 @@ VirtualScene demoVirtualScene(const String& path)
     dome.anchor = "building";
     dome.distance = 0.05;
     dome.size = 0.6;
-    dome.offset = Vec3d(-0.72, 0, 0);
+    dome.offset = Vec3d(-0.45, 0, 0);
     SceneObject tree;
     tree.name = "tree";
     tree.shape = "tree";
