@@ -166,8 +166,9 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
                   << acc.band / acc.frames << " within8(vs ss4) " << acc4.within / acc.frames
                   << " band(vs ss4) " << acc4.band / acc.frames << std::endl;
         // Issue 5: >= 99.5% of pixels within 8 grey levels with GT cameras and built clones
-        // (measured 99.97% at k = 1, 99.91% at k = 3). The 1 px boundary target is not met
-        // (1.25 px measured: the clones' outline error), so it is reported, not asserted.
+        // (measured 99.91% at k = 1, 99.86% at k = 3). The 1 px boundary target is not met
+        // (2.74 px measured: the dome stands in the L-block's inner corner, which the
+        // silhouettes cannot carve), so it is reported, not asserted.
         const double kMinWithin = 0.995;
         EXPECT_GE(acc.within / acc.frames, kMinWithin) << "k=" << k;
     }
