@@ -7,6 +7,8 @@
 
 #include "test_precomp.hpp"
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -50,7 +52,9 @@ const CliData& cliData()
     static CliData d;
     if (d.ok)
         return d;
-    d.dir = (fs::temp_directory_path() / "augocc_test" / "Augocc_CliComposite").string();
+    // One folder per process: CTest runs each test in its own process, two at a time.
+    d.dir = (fs::temp_directory_path() / "augocc_test" /
+             cv::format("Augocc_CliComposite.%d", (int)getpid())).string();
     fs::remove_all(d.dir);
     fs::create_directories(d.dir);
     SceneSynthesizer::Params sp;
