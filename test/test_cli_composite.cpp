@@ -14,8 +14,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
-namespace opencv_test {
-namespace {
+namespace opencv_test
+{
+namespace
+{
 using namespace cv;
 using namespace cv::augocc;
 namespace fs = std::filesystem;
@@ -34,8 +36,8 @@ const int kFrames = 6;
 
 void writeAvi(const String& path, const std::vector<Mat>& frames, int count)
 {
-    VideoWriter w(path, CAP_FFMPEG, VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
-                  frames[0].size(), true);
+    VideoWriter w(path, CAP_FFMPEG, VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, frames[0].size(),
+                  true);
     ASSERT_TRUE(w.isOpened()) << path;
     for (int i = 0; i < count; i++)
         w.write(frames[i]);
@@ -54,7 +56,8 @@ const CliData& cliData()
         return d;
     // One folder per process: CTest runs each test in its own process, two at a time.
     d.dir = (fs::temp_directory_path() / "augocc_test" /
-             cv::format("Augocc_CliComposite.%d", (int)getpid())).string();
+             cv::format("Augocc_CliComposite.%d", (int)getpid()))
+                .string();
     fs::remove_all(d.dir);
     fs::create_directories(d.dir);
     SceneSynthesizer::Params sp;
@@ -108,18 +111,24 @@ String joined(const std::vector<String>& v)
     return s;
 }
 
-// Runs the command, expects exit 2, one message that contains every `needles` entry, and an
-// empty output folder.
-void expectBadInput(const String& args, const std::vector<String>& needles, const String& outDir)
+// Runs the command; success when it exits 2 with one message that contains every `needles`
+// entry and leaves the output folder empty.
+testing::AssertionResult badInputRejected(const String& args, const std::vector<String>& needles,
+                                          const String& outDir)
 {
     String output;
     const int status = runCommand(augoccBinary() + " " + args, &output);
-    EXPECT_EQ(2, status) << args << "\n" << output;
+    if (status != 2)
+        return testing::AssertionFailure()
+               << "exit status " << status << ", expected 2: " << args << "\n"
+               << output;
     for (const String& n : needles)
-        EXPECT_NE(String::npos, output.find(n)) << "message should name '" << n << "': "
-                                                << output;
+        if (output.find(n) == String::npos)
+            return testing::AssertionFailure() << "message should name '" << n << "': " << output;
     const std::vector<String> left = listAll(outDir);
-    EXPECT_TRUE(left.empty()) << "output left behind: " << joined(left);
+    if (!left.empty())
+        return testing::AssertionFailure() << "output left behind: " << joined(left);
+    return testing::AssertionSuccess();
 }
 
 class Augocc_CliComposite : public testing::Test
@@ -151,25 +160,30 @@ TEST_F(Augocc_CliComposite, valid_inputs_write_the_outputs)
     const CliData& d = cliData();
     const String mp4 = (fs::path(out_) / "out.mp4").string();
     String output;
-    ASSERT_EQ(0, runCommand(augoccBinary() + " " + compositeArgs(d.video, d.rec, d.scene, mp4,
-                            "--frames 1:4 --hard-edges"), &output)) << output;
+    ASSERT_EQ(
+        0, runCommand(augoccBinary() + " " +
+                          compositeArgs(d.video, d.rec, d.scene, mp4, "--frames 1:4 --hard-edges"),
+                      &output))
+        << output;
     VideoCapture cap(mp4);
     ASSERT_TRUE(cap.isOpened());
     EXPECT_EQ(3, (int)cap.get(CAP_PROP_FRAME_COUNT));
     const String pngs = (fs::path(out_) / "pngs").string();
-    ASSERT_EQ(0, runCommand(augoccBinary() + " " + compositeArgs(d.frames, d.rec, d.scene, pngs,
-                            "--frames 4:"), &output)) << output;
+    ASSERT_EQ(0, runCommand(augoccBinary() + " " +
+                                compositeArgs(d.frames, d.rec, d.scene, pngs, "--frames 4:"),
+                            &output))
+        << output;
     EXPECT_TRUE(fs::exists(fs::path(pngs) / "0004.png"));
     EXPECT_TRUE(fs::exists(fs::path(pngs) / "0005.png"));
-    EXPECT_EQ(4u, listAll(out_).size()) << joined(listAll(out_));  // out.mp4, pngs, 2 PNGs
+    EXPECT_EQ(4u, listAll(out_).size()) << joined(listAll(out_)); // out.mp4, pngs, 2 PNGs
 }
 
 TEST_F(Augocc_CliComposite, bad_input_missing_video)
 {
     const CliData& d = cliData();
     const String missing = (fs::path(out_).parent_path() / "no_such_video.mp4").string();
-    expectBadInput(compositeArgs(missing, d.rec, d.scene, out_ + "/out.mp4"),
-                   {"no_such_video.mp4"}, out_);
+    EXPECT_TRUE(badInputRejected(compositeArgs(missing, d.rec, d.scene, out_ + "/out.mp4"),
+                                 {"no_such_video.mp4"}, out_));
 }
 
 TEST_F(Augocc_CliComposite, bad_input_corrupt_video)
@@ -177,8 +191,10 @@ TEST_F(Augocc_CliComposite, bad_input_corrupt_video)
     const CliData& d = cliData();
     const String bad = tempDir("in") + "/corrupt.mp4";
     writeText(bad, String(4096, '\x5a'));
-    expectBadInput(compositeArgs(bad, d.rec, d.scene, out_ + "/out.mp4"), {"corrupt.mp4"}, out_);
-    expectBadInput(compositeArgs(bad, d.rec, d.scene, out_ + "/pngs"), {"corrupt.mp4"}, out_);
+    EXPECT_TRUE(badInputRejected(compositeArgs(bad, d.rec, d.scene, out_ + "/out.mp4"),
+                                 {"corrupt.mp4"}, out_));
+    EXPECT_TRUE(badInputRejected(compositeArgs(bad, d.rec, d.scene, out_ + "/pngs"),
+                                 {"corrupt.mp4"}, out_));
 }
 
 TEST_F(Augocc_CliComposite, bad_input_video_cut_short)
@@ -194,8 +210,8 @@ TEST_F(Augocc_CliComposite, bad_input_video_cut_short)
     }
     // Folders made for the output go too.
     for (const char* name : {"out.mp4", "pngs", "new/sub/out.mp4", "new/pngs"})
-        expectBadInput(compositeArgs(cut, d.rec, d.scene, out_ + "/" + name), {"cut.avi"},
-                       out_);
+        EXPECT_TRUE(badInputRejected(compositeArgs(cut, d.rec, d.scene, out_ + "/" + name),
+                                     {"cut.avi"}, out_));
 }
 
 TEST_F(Augocc_CliComposite, bad_input_mesh_does_not_parse)
@@ -204,9 +220,9 @@ TEST_F(Augocc_CliComposite, bad_input_mesh_does_not_parse)
     const String in = tempDir("in");
     writeText(in + "/broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7 9\nthis is not an OBJ file\n");
     writeText(in + "/scene.yml", "%YAML:1.0\n---\nobjects:\n  - { name: statue, mesh: "
-              "broken.obj, position: [0, 0, 0] }\n");
-    expectBadInput(compositeArgs(d.video, d.rec, in + "/scene.yml", out_ + "/out.mp4"),
-                   {"broken.obj"}, out_);
+                                 "broken.obj, position: [0, 0, 0] }\n");
+    EXPECT_TRUE(badInputRejected(
+        compositeArgs(d.video, d.rec, in + "/scene.yml", out_ + "/out.mp4"), {"broken.obj"}, out_));
 }
 
 TEST_F(Augocc_CliComposite, bad_input_scene_unknown_key)
@@ -214,18 +230,19 @@ TEST_F(Augocc_CliComposite, bad_input_scene_unknown_key)
     const CliData& d = cliData();
     const String in = tempDir("in");
     writeText(in + "/scene.yml", "%YAML:1.0\n---\nobjects:\n  - { name: dome, shape: dome, "
-              "positon: [0, 0, 0] }\n");
-    expectBadInput(compositeArgs(d.video, d.rec, in + "/scene.yml", out_ + "/out.mp4"),
-                   {"scene.yml", "positon"}, out_);
+                                 "positon: [0, 0, 0] }\n");
+    EXPECT_TRUE(
+        badInputRejected(compositeArgs(d.video, d.rec, in + "/scene.yml", out_ + "/out.mp4"),
+                         {"scene.yml", "positon"}, out_));
 }
 
 TEST_F(Augocc_CliComposite, bad_input_frames_out_of_range)
 {
     const CliData& d = cliData();
     for (const char* range : {"4:99", "6:", "3:2", "a:b", "-1:3", "2:2"})
-        expectBadInput(compositeArgs(d.video, d.rec, d.scene, out_ + "/out.mp4",
-                                     String("--frames ") + range),
-                       {"frame"}, out_);
+        EXPECT_TRUE(badInputRejected(
+            compositeArgs(d.video, d.rec, d.scene, out_ + "/out.mp4", String("--frames ") + range),
+            {"frame"}, out_));
 }
 
 TEST_F(Augocc_CliComposite, bad_input_reconstruction_does_not_match_video)
@@ -242,8 +259,8 @@ TEST_F(Augocc_CliComposite, bad_input_reconstruction_does_not_match_video)
             frames.push_back(f.clone());
         const String shortVideo = in + "/short.avi";
         writeAvi(shortVideo, frames, kFrames - 2);
-        expectBadInput(compositeArgs(shortVideo, d.rec, d.scene, out_ + "/out.mp4"),
-                       {"short.avi", "reconstruction"}, out_);
+        EXPECT_TRUE(badInputRejected(compositeArgs(shortVideo, d.rec, d.scene, out_ + "/out.mp4"),
+                                     {"short.avi", "reconstruction"}, out_));
     }
     // Another image size.
     {
@@ -251,8 +268,8 @@ TEST_F(Augocc_CliComposite, bad_input_reconstruction_does_not_match_video)
         big.imageSize = Size(2 * rec.imageSize.width, 2 * rec.imageSize.height);
         const String p = in + "/big.yml";
         writeReconstruction(p, big);
-        expectBadInput(compositeArgs(d.video, p, d.scene, out_ + "/out.mp4"), {"big.yml"},
-                       out_);
+        EXPECT_TRUE(badInputRejected(compositeArgs(d.video, p, d.scene, out_ + "/out.mp4"),
+                                     {"big.yml"}, out_));
     }
     // A frame without a camera.
     {
@@ -260,8 +277,8 @@ TEST_F(Augocc_CliComposite, bad_input_reconstruction_does_not_match_video)
         gap.cameras.erase(gap.cameras.begin() + 2);
         const String p = in + "/gap.yml";
         writeReconstruction(p, gap);
-        expectBadInput(compositeArgs(d.video, p, d.scene, out_ + "/out.mp4"),
-                       {"gap.yml", "frame 2"}, out_);
+        EXPECT_TRUE(badInputRejected(compositeArgs(d.video, p, d.scene, out_ + "/out.mp4"),
+                                     {"gap.yml", "frame 2"}, out_));
     }
 }
 
@@ -275,11 +292,11 @@ TEST_F(Augocc_CliComposite, bad_input_optional_outputs_left_clean)
         const String all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
         writeText(cut, all.substr(0, all.size() * 2 / 3));
     }
-    expectBadInput(compositeArgs(cut, d.rec, d.scene, out_ + "/out.mp4",
-                                 "--mattes " + q(out_ + "/mattes") + " --depth " +
-                                     q(out_ + "/depth") + " --virtual-layer " +
-                                     q(out_ + "/layer")),
-                   {"cut.avi"}, out_);
+    EXPECT_TRUE(badInputRejected(compositeArgs(cut, d.rec, d.scene, out_ + "/out.mp4",
+                                               "--mattes " + q(out_ + "/mattes") + " --depth " +
+                                                   q(out_ + "/depth") + " --virtual-layer " +
+                                                   q(out_ + "/layer")),
+                                 {"cut.avi"}, out_));
 }
 
 // `augocc run`: the bad inputs are found before any work, and --out-dir stays empty.
@@ -298,10 +315,11 @@ TEST_F(Augocc_CliRun, bad_input_missing_or_corrupt_video)
 {
     const CliData& d = cliData();
     const String in = tempDir("in");
-    expectBadInput(runArgs(in + "/no_such_video.mp4", d.masks, d.scene), {"no_such_video.mp4"},
-                   out_);
+    EXPECT_TRUE(badInputRejected(runArgs(in + "/no_such_video.mp4", d.masks, d.scene),
+                                 {"no_such_video.mp4"}, out_));
     writeText(in + "/corrupt.mp4", String(4096, '\x5a'));
-    expectBadInput(runArgs(in + "/corrupt.mp4", d.masks, d.scene), {"corrupt.mp4"}, out_);
+    EXPECT_TRUE(
+        badInputRejected(runArgs(in + "/corrupt.mp4", d.masks, d.scene), {"corrupt.mp4"}, out_));
 }
 
 TEST_F(Augocc_CliRun, bad_input_video_cut_short)
@@ -314,7 +332,7 @@ TEST_F(Augocc_CliRun, bad_input_video_cut_short)
         const String all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
         writeText(cut, all.substr(0, all.size() * 2 / 3));
     }
-    expectBadInput(runArgs(cut, d.masks, d.scene), {"cut.avi"}, out_);
+    EXPECT_TRUE(badInputRejected(runArgs(cut, d.masks, d.scene), {"cut.avi"}, out_));
 }
 
 TEST_F(Augocc_CliRun, bad_input_mesh_and_scene)
@@ -323,11 +341,13 @@ TEST_F(Augocc_CliRun, bad_input_mesh_and_scene)
     const String in = tempDir("in");
     writeText(in + "/broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7 9\nthis is not an OBJ file\n");
     writeText(in + "/mesh.yml", "%YAML:1.0\n---\nobjects:\n  - { name: statue, mesh: "
-              "broken.obj, position: [0, 0, 0] }\n");
-    expectBadInput(runArgs(d.video, d.masks, in + "/mesh.yml"), {"broken.obj"}, out_);
+                                "broken.obj, position: [0, 0, 0] }\n");
+    EXPECT_TRUE(
+        badInputRejected(runArgs(d.video, d.masks, in + "/mesh.yml"), {"broken.obj"}, out_));
     writeText(in + "/key.yml", "%YAML:1.0\n---\nobjects:\n  - { name: dome, shape: dome, "
-              "behind: building, colour: red }\n");
-    expectBadInput(runArgs(d.video, d.masks, in + "/key.yml"), {"key.yml", "colour"}, out_);
+                               "behind: building, colour: red }\n");
+    EXPECT_TRUE(
+        badInputRejected(runArgs(d.video, d.masks, in + "/key.yml"), {"key.yml", "colour"}, out_));
 }
 
 TEST_F(Augocc_CliRun, bad_input_masks_do_not_match_video)
@@ -345,7 +365,7 @@ TEST_F(Augocc_CliRun, bad_input_masks_do_not_match_video)
             big[o.first][f.first] = up;
         }
     writeMasks(masks, big);
-    expectBadInput(runArgs(d.video, masks, d.scene), {"masks"}, out_);
+    EXPECT_TRUE(badInputRejected(runArgs(d.video, masks, d.scene), {"masks"}, out_));
     // Masks for frames the video does not have.
     const String late = tempDir("late");
     ObjectMasks shifted;
@@ -353,7 +373,7 @@ TEST_F(Augocc_CliRun, bad_input_masks_do_not_match_video)
         for (const auto& f : o.second)
             shifted[o.first][f.first + kFrames] = f.second;
     writeMasks(late, shifted);
-    expectBadInput(runArgs(d.video, late, d.scene), {"late", "video.avi"}, out_);
+    EXPECT_TRUE(badInputRejected(runArgs(d.video, late, d.scene), {"late", "video.avi"}, out_));
 }
 
 } // namespace
