@@ -177,6 +177,34 @@ void checkInput(const Tracks& tracks, const Reconstruction& rec)
     }
 }
 
+// Visits every observation of a finite point, point by point: the order in which the Schur
+// elimination visits the residual blocks, so that Ceres' blocks and the costs lie in memory in the
+// order they are used. fn(i, p, o, pp) gets the camera index, the point, the observation and the
+// camera's principal point; used[p] is set for every point with an observation.
+template <typename Fn>
+void forEachObservationPointMajor(const Tracks& tracks, const Reconstruction& rec, const Mat& X,
+                                  std::vector<uchar>& used, Fn fn)
+{
+    const int n = (int)rec.cameras.size();
+    std::vector<Point2d> pp(n);
+    for (int i = 0; i < n; i++)
+        pp[i] = rec.cameras[i].principalPoint();
+    used.assign(X.rows, 0);
+    for (int p = 0; p < X.rows; p++)
+    {
+        if (!std::isfinite(X.at<double>(p, 0)))
+            continue;
+        for (int i = 0; i < n; i++)
+        {
+            const Point2f o = tracks.tracks.at<Point2f>(rec.cameras[i].frame, p);
+            if (!std::isfinite(o.x))
+                continue;
+            fn(i, p, o, pp[i]);
+            used[p] = 1;
+        }
+    }
+}
+
 bool solverUsable(const ceres::Solver::Summary& summary, const char* what)
 {
     if (!summary.IsSolutionUsable())
@@ -286,28 +314,13 @@ bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction&
     ceres::EigenQuaternionManifold quatManifold;
     std::unique_ptr<ceres::LossFunction> loss(makeLoss());
     ceres::ParameterBlockOrdering* ordering = new ceres::ParameterBlockOrdering;
-    std::vector<uchar> used(P, 0);
-    std::vector<Point2d> pp(n);
-    for (int i = 0; i < n; i++)
-        pp[i] = rec.cameras[i].principalPoint();
-    // Point by point: the order in which the Schur elimination visits the residual blocks, so
-    // that Ceres' blocks and the costs lie in memory in the order they are used.
-    for (int p = 0; p < P; p++)
-    {
-        double* x = X.ptr<double>(p);
-        if (!std::isfinite(x[0]))
-            continue;
-        for (int i = 0; i < n; i++)
-        {
-            const Point2f o = tracks.tracks.at<Point2f>(rec.cameras[i].frame, p);
-            if (!std::isfinite(o.x))
-                continue;
-            costs.emplace_back(o.x, o.y, pp[i].x, pp[i].y);
-            problem.AddResidualBlock(&costs.back(), loss.get(), q[i].coeffs().data(), t[i].val,
-                                     params_.perFrameScale ? &s[i] : &sGlobal, x);
-            used[p] = 1;
-        }
-    }
+    std::vector<uchar> used;
+    forEachObservationPointMajor(tracks, rec, X, used,
+                                 [&](int i, int p, const Point2f& o, const Point2d& pp) {
+        costs.emplace_back(o.x, o.y, pp.x, pp.y);
+        problem.AddResidualBlock(&costs.back(), loss.get(), q[i].coeffs().data(), t[i].val,
+                                 params_.perFrameScale ? &s[i] : &sGlobal, X.ptr<double>(p));
+    });
     for (int i = 0; i < n; i++)
     {
         if (problem.HasParameterBlock(q[i].coeffs().data()))
@@ -415,26 +428,13 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     ceres::EigenQuaternionManifold quatManifold;
     std::unique_ptr<ceres::LossFunction> loss(makeLoss());
     ceres::ParameterBlockOrdering* ordering = new ceres::ParameterBlockOrdering;
-    std::vector<uchar> used(P, 0);
-    std::vector<Point2d> pp(n);
-    for (int i = 0; i < n; i++)
-        pp[i] = rec.cameras[i].principalPoint();
-    for (int p = 0; p < P; p++)   // point by point, as in refineOrthoBA
-    {
-        double* x = X.ptr<double>(p);
-        if (!std::isfinite(x[0]))
-            continue;
-        for (int i = 0; i < n; i++)
-        {
-            const Point2f o = tracks.tracks.at<Point2f>(rec.cameras[i].frame, p);
-            if (!std::isfinite(o.x))
-                continue;
-            costs.emplace_back(o.x, o.y, pp[i].x, pp[i].y);
-            problem.AddResidualBlock(&costs.back(), loss.get(), q[i].coeffs().data(), t[i].val,
-                                     &s, &kappa, x);
-            used[p] = 1;
-        }
-    }
+    std::vector<uchar> used;
+    forEachObservationPointMajor(tracks, rec, X, used,
+                                 [&](int i, int p, const Point2f& o, const Point2d& pp) {
+        costs.emplace_back(o.x, o.y, pp.x, pp.y);
+        problem.AddResidualBlock(&costs.back(), loss.get(), q[i].coeffs().data(), t[i].val, &s,
+                                 &kappa, X.ptr<double>(p));
+    });
     for (int i = 0; i < n; i++)
     {
         if (problem.HasParameterBlock(q[i].coeffs().data()))
