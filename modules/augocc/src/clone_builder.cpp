@@ -693,18 +693,9 @@ int64 dropUnseenVoxels(ObjectClone& obj, const Reconstruction& rec)
                         continue;
                     for (size_t q = 0; q < projs.size(); q++)
                     {
-                        int x0, x1, y0, y1;
-                        double z;
-                        if (!projs[q].footprint(i, j, k, x0, x1, y0, y1, z))
+                        Point px;
+                        if (!projs[q].centrePixel(i, j, k, px))
                             continue;
-                        const double u = projs[q].M(0, 0) * i + (projs[q].M(0, 1) * j +
-                                         projs[q].M(0, 2) * k + projs[q].c[0]);
-                        const double v = projs[q].M(1, 0) * i + (projs[q].M(1, 1) * j +
-                                         projs[q].M(1, 2) * k + projs[q].c[1]);
-                        const double w = projs[q].affine ? 1.0
-                                         : projs[q].M(2, 0) * i + (projs[q].M(2, 1) * j +
-                                           projs[q].M(2, 2) * k + projs[q].c[2]);
-                        const Point px(cvRound(u / w), cvRound(v / w));
                         if (px.x >= 0 && px.y >= 0 && px.x < masks[q]->cols &&
                             px.y < masks[q]->rows && masks[q]->at<uchar>(px) > 127)
                         {
@@ -715,14 +706,7 @@ int64 dropUnseenVoxels(ObjectClone& obj, const Reconstruction& rec)
                 }
             }
     });
-    bool anySeen = false;
-    for (uchar v : g.data)
-        if (v == kSeen)
-        {
-            anySeen = true;
-            break;
-        }
-    if (!anySeen)
+    if (std::find(g.data.begin(), g.data.end(), kSeen) == g.data.end())
     {
         // Nothing seen at all (silhouettes thinner than the voxel spacing): no evidence either
         // way, keep the clone as carved.

@@ -61,6 +61,19 @@ struct VoxelProjector
     Vec3d camVoxel;   //!< perspective: camera centre in voxel coordinates
     double ruAffine = 0, rvAffine = 0;  //!< affine: footprint half extents in pixels
 
+    /** @brief Pixel (rounded) of the centre of voxel (i, j, k). Returns false when the voxel is
+    not in front of the camera. */
+    inline bool centrePixel(double i, double j, double k, Point& px) const
+    {
+        const double u = M(0, 0) * i + (M(0, 1) * j + M(0, 2) * k + c[0]);
+        const double v = M(1, 0) * i + (M(1, 1) * j + M(1, 2) * k + c[1]);
+        const double w = affine ? 1.0 : M(2, 0) * i + (M(2, 1) * j + M(2, 2) * k + c[2]);
+        if (!(w > 1e-12))
+            return false;
+        px = Point(cvRound(u / w), cvRound(v / w));
+        return true;
+    }
+
     /** @brief Footprint of voxel (i, j, k): pixel rectangle [x0, x1] x [y0, y1] (inclusive, not
     clipped) and the centre's depth. Returns false when the voxel is not in front of the camera. */
     inline bool footprint(double i, double j, double k, int& x0, int& x1, int& y0, int& y1,
