@@ -59,19 +59,24 @@ public:
                      frameIndex_, frame.cols, frame.rows, size_.width, size_.height));
         Mat gray;
         if (frame.type() == CV_8UC3)
-            cvtColor(frame, gray, COLOR_BGR2GRAY);
+        {
+            cvtColor(frame, gray_, COLOR_BGR2GRAY);  // the buffer is reused frame to frame
+            gray = gray_;
+        }
         else if (frame.type() == CV_8UC1)
             gray = frame;
         else
             CV_Error(Error::StsUnsupportedFormat, cv::format("frame %d has type %s; expected "
                      "8-bit BGR or grey", frameIndex_, typeToString(frame.type()).c_str()));
-        std::vector<Mat> pyr;
+        // Two pyramids alternate (this frame's and the previous one), so that their buffers
+        // are allocated once per session, not once per frame.
+        std::vector<Mat>& pyr = nextPyr_;
         buildOpticalFlowPyramid(gray, pyr, p_.winSize, p_.levels, true);
         if (!live_.empty())
             trackLive(pyr);
         if ((int)live_.size() < p_.redetectRatio * p_.maxTracks)
             detect(gray);
-        prevPyr_ = std::move(pyr);
+        std::swap(prevPyr_, nextPyr_);
         frameIndex_++;
     }
 
@@ -251,7 +256,8 @@ private:
     Size size_;
     Mat excluded_;
     TermCriteria criteria_;
-    std::vector<Mat> prevPyr_;
+    Mat gray_;
+    std::vector<Mat> prevPyr_, nextPyr_;
     std::vector<Point2f> prev_, next_, from_, to_;   // buffers of trackLive
     std::vector<TrackRec> tracks_;
     std::vector<int> live_;
