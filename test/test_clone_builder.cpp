@@ -776,3 +776,108 @@ TEST(Augocc_CloneBuilder, accuracy_sfm_cameras)
 
 } // namespace
 } // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+
+using namespace cv;
+using namespace cv::augocc;
+
+// Depth of the clones against the truth where the object is seen: mean |dz| in voxels, fraction
+// of pixels more than 3 voxels in front.
+void depthFigures(const CloneSet& clones, const SyntheticScene& s, const String& name, const char* tag = "")
+{
+    {
+        Mat mt, dp;
+        const Camera& cam = s.groundTruth.camera(30);
+        clones.render(name, 30, cam, s.groundTruth.imageSize, mt, dp);
+        Mat e = (s.depth[30] - dp) / clones.voxelSize(name);
+        Mat img = s.frames[30] / 3;
+        for (int y = 0; y < e.rows; y++) for (int x = 0; x < e.cols; x++)
+            if (mt.at<uchar>(y, x)) { float v = e.at<float>(y, x); int c = (int)std::min(255.f, std::abs(v) * 4); img.at<Vec3b>(y, x) = v > 0 ? Vec3b(0, (uchar)c, (uchar)std::max(60, c)) : Vec3b((uchar)std::max(60, c), (uchar)c, 0); }
+        imwrite(cv::format("/tmp/photo_depth_%s%s.png", name.c_str(), tag), img);
+    }
+    double sum = 0, front = 0; int64 n = 0;
+    const double h = clones.voxelSize(name);
+    for (const Camera& cam : s.groundTruth.cameras)
+    {
+        Mat mt, dp;
+        clones.render(name, cam.frame, cam, s.groundTruth.imageSize, mt, dp);
+        const Mat& vis = s.visibleMasks.at(name).at(cam.frame);
+        const Mat& gt = s.depth[cam.frame];
+        for (int y = 0; y < dp.rows; y++)
+            for (int x = 0; x < dp.cols; x++)
+                if (vis.at<uchar>(y, x) && mt.at<uchar>(y, x))
+                {
+                    const double dz = (gt.at<float>(y, x) - dp.at<float>(y, x)) / h;
+                    sum += std::abs(dz);
+                    front += dz > 3;
+                    n++;
+                }
+    }
+    std::cout << "   depth " << name << ": mean |dz| " << sum / n << " voxels, in front by > 3 voxels " << front / n << std::endl;
+}
+
+void printSynth(const char* tag, const String& name, const SynthFigures& f)
+{
+    std::cout << tag << " " << name << ": key min IoU " << f.keyMin << ", non-key mean IoU "
+              << f.nonKeyMean << " worst " << f.nonKeyMin << ", boundary " << f.boundary
+              << " px, IoU outside others' pixels " << f.visibleMean << " worst " << f.visibleMin
+              << ", recall " << f.recall << std::endl;
+}
+
+TEST(Augocc_CloneBuilder_Photo, DISABLED_experiment)
+{
+    SceneSynthesizer::Params sp;
+    if (getenv("AUGOCC_PHOTO_PERSP"))
+        sp.model = PERSPECTIVE;
+    SyntheticScene s;
+    SceneSynthesizer::create(sp)->synthesize(s);
+    CloneBuilder::Params p;
+    if (getenv("AUGOCC_PHOTO_T"))
+        p.photoThreshold = atof(getenv("AUGOCC_PHOTO_T"));
+    if (getenv("AUGOCC_PHOTO_A"))
+        p.photoMinAgreement = atof(getenv("AUGOCC_PHOTO_A"));
+    Ptr<CloneBuilder> b = CloneBuilder::create(p);
+    Ptr<CloneSet> clones = b->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+    std::map<String, SynthFigures> before;
+    for (const String& name : clones->objectNames())
+    {
+        before[name] = measureSynth(*clones, s, name);
+        printSynth("before", name, before[name]);
+        depthFigures(*clones, s, name);
+    }
+    ObjectMasks m0;
+    renderMattes(*clones, s.groundTruth, m0);
+    const int64 t0 = getTickCount();
+    const int64 n = b->refine(*clones, s.groundTruth, s.frames);
+    const double ms = (getTickCount() - t0) * 1000.0 / getTickFrequency();
+    std::cout << "refine: " << n << " voxels carved in " << ms << " ms" << std::endl;
+    for (const String& name : clones->objectNames())
+    {
+        printSynth("after ", name, measureSynth(*clones, s, name));
+        depthFigures(*clones, s, name, "_after");
+    }
+    ObjectMasks m1;
+    renderMattes(*clones, s.groundTruth, m1);
+    for (int f : {5, 30, 50})
+        for (const String& name : clones->objectNames())
+        {
+            // red: matte outside the truth, green: truth the matte misses; before | after
+            Mat img[2];
+            const Mat& whole = s.wholeMasks.at(name).at(f);
+            const Mat* mm[2] = {&m0[name][f], &m1[name][f]};
+            for (int q = 0; q < 2; q++)
+            {
+                img[q] = s.frames[f] / 2;
+                img[q].setTo(Scalar(0, 0, 255), *mm[q] & ~whole);
+                img[q].setTo(Scalar(0, 255, 0), whole & ~*mm[q]);
+            }
+            Mat both;
+            hconcat(img[0], img[1], both);
+            imwrite(cv::format("/tmp/photo_%s_%02d.png", name.c_str(), f), both);
+        }
+}
+
+} // namespace
+} // namespace opencv_test

@@ -120,10 +120,17 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
     SyntheticScene scene;
     synth->synthesize(scene);
-    Ptr<CloneSet> clones = CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks);
-    const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth, clones.get());
+    Ptr<CloneBuilder> builder = CloneBuilder::create();
+    Ptr<CloneSet> silhouetteClones = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth,
+                                                silhouetteClones.get());
+    // Clones from the silhouettes alone, then carved further by photo-consistency.
+    Ptr<CloneSet> photoClones = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    builder->refine(*photoClones, scene.groundTruth, scene.frames);
+    for (int photo : {0, 1})
     for (int k : {1, 3})
     {
+        const Ptr<CloneSet>& clones = photo ? photoClones : silhouetteClones;
         Compositor::Params cp;
         cp.supersample = k;
         Ptr<Compositor> comp = Compositor::create(cp);
@@ -156,12 +163,15 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
             acc.frames++;
             if (f == 15)
             {
-                imwrite("/tmp/comp_k" + std::to_string(k) + ".png", result);
+                Mat diff, row;
+                absdiff(result, truth, diff);
+                hconcat(std::vector<Mat>{truth, result, diff * 4}, row);
+                imwrite("/tmp/comp_p" + std::to_string(photo) + "_k" + std::to_string(k) + ".png", row(Rect(100, 100, 1720, 260)));
                 imwrite("/tmp/truth4.png", truth4);
                 imwrite("/tmp/truth1.png", truth);
             }
         }
-        std::cout << "k=" << k << " within8(vs ss1) " << acc.within / acc.frames
+        std::cout << (photo ? "photo-refined" : "silhouettes") << " k=" << k << " within8(vs ss1) " << acc.within / acc.frames
                   << " boundary " << acc.boundary / acc.frames << " band(vs ss1) "
                   << acc.band / acc.frames << " within8(vs ss4) " << acc4.within / acc.frames
                   << " band(vs ss4) " << acc4.band / acc.frames << std::endl;
@@ -182,7 +192,10 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
     SyntheticScene scene;
     synth->synthesize(scene);
-    Ptr<CloneSet> built = CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks);
+    Ptr<CloneBuilder> builder = CloneBuilder::create();
+    Ptr<CloneSet> built = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    Ptr<CloneSet> refined = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    builder->refine(*refined, scene.groundTruth, scene.frames);
     MeshClones exact(scene.objectNames, scene.objectMeshes);
     const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth, built.get());
     Compositor::Params hp;
@@ -192,7 +205,7 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
     struct V { int exact, k, r; double eps; };
     const V variants[] = {{0, 1, 0, 1e-3}, {0, 3, 0, 1e-3}, {0, 1, 2, 1e-3}, {0, 3, 2, 1e-3},
                           {0, 3, 3, 1e-3}, {0, 3, 2, 1e-2}, {0, 3, 2, 1e-4}, {1, 1, 0, 1e-3},
-                          {1, 3, 0, 1e-3}, {1, 3, 2, 1e-3}};
+                          {1, 3, 0, 1e-3}, {1, 3, 2, 1e-3}, {2, 1, 0, 1e-3}, {2, 3, 0, 1e-3}};
     std::vector<double> bandOf;
     for (const V& v : variants)
         {
@@ -211,8 +224,9 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
                 Mat bg, truth4, result, layer, refImg, refLayer, silImg, silLayer;
                 synth->renderWithVirtual(f, {}, bg, 4);
                 synth->renderWithVirtual(f, meshes, truth4, 4);
-                comp->composite(bg, f, cam, useExact ? (const CloneSet&)exact : *built, result,
-                                layer);
+                const CloneSet& clones = useExact == 1 ? (const CloneSet&)exact
+                                         : useExact == 2 ? *refined : *built;
+                comp->composite(bg, f, cam, clones, result, layer);
                 ref->composite(bg, cam, realDepth(scene, f), refImg, refLayer);
                 ref->composite(bg, cam, noArray(), silImg, silLayer);
                 std::vector<Mat> ch, rch, sch;
@@ -225,7 +239,7 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
                 bnd += s.boundaryDistance;
                 n++;
             }
-            std::cout << (useExact ? "exact" : "built") << " k=" << k << " r=" << v.r << " eps="
+            std::cout << (useExact == 1 ? "exact" : useExact == 2 ? "built+photo" : "built") << " k=" << k << " r=" << v.r << " eps="
                       << v.eps << " band(vs ss4) "
                       << band / n << " boundary " << bnd / n << std::endl;
             bandOf.push_back(band / n);
