@@ -14,8 +14,8 @@ namespace augocc {
 CloneBuilder::Params::Params()
     : voxelPixels(1.0), maxVoxels((int64)1 << 27), maxEnlargeIterations(20),
       orientation(ORIENT_AUTO), userRotation(0, 0, 0), raysPerPixel(2), patchRule(PATCH_NEAREST),
-      occlusionAware(true), trimFraction(0.02), minPoints(4), photoThreshold(10),
-      photoMinAgreement(0.8), photoMinViews(8), photoRounds(1)
+      occlusionAware(true), trimFraction(0.02), minPoints(4), photoThreshold(15),
+      photoMinAgreement(0.95), photoMinViews(8), photoRounds(1), photoPatchStep(0)
 {
 }
 
@@ -585,6 +585,8 @@ public:
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoMinViews must be >= 2");
         if (p.photoRounds < 1)
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoRounds must be >= 1");
+        if (p.photoPatchStep < 0 || p.photoPatchStep > 8)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoPatchStep must be in [0, 8]");
         params_ = p;
     }
 
@@ -926,6 +928,7 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
     pp.minAgreement = params_.photoMinAgreement;
     pp.minViews = params_.photoMinViews;
     pp.rounds = params_.photoRounds;
+    pp.patchStep = params_.photoPatchStep;
     const std::map<String, int64> carved = photoCarve(*set, rec, frames, pp);
     int64 total = 0;
     for (const auto& c : carved)

@@ -59,10 +59,11 @@ CV_EXPORTS std::vector<uint32_t> computePatches(const ObjectClone& obj, const Ca
 //! Photo-consistency carving parameters (CloneBuilder::Params::photo*).
 struct PhotoCarveParams
 {
-    double threshold = 10;
-    double minAgreement = 0.8;
+    double threshold = 15;
+    double minAgreement = 0.95;
     int minViews = 8;
     int rounds = 1;
+    int patchStep = 0;
 };
 
 /** @brief Space carving by photo-consistency on every frame with a camera (CloneBuilder::refine):

@@ -31,49 +31,63 @@ const double kExposureTolerance = 0.1;
 const int kMinParallelItems = 512;
 
 
-// Colour agreement of one voxel over its views (K&S's consistency check): the reference is the
-// per-channel median of the views' colours at the centre pixel; a view agrees when some pixel of
-// its 3x3 neighbourhood (half-pixel projection and texture aliasing) matches the reference within
-// `threshold` per channel, after the view's best exposure gain within kExposureTolerance.
+// Colour match of view pixel p against ref within `threshold` per channel, after the best gain.
+inline bool matches(const uchar* p, const float* ref, double threshold)
+{
+    const double cr = p[0] * ref[0] + p[1] * ref[1] + p[2] * ref[2];
+    const double cc = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    double g = cc > 0 ? cr / cc : 1.0;
+    g = std::min(1.0 + kExposureTolerance, std::max(1.0 / (1.0 + kExposureTolerance), g));
+    return std::abs(g * p[0] - ref[0]) <= threshold && std::abs(g * p[1] - ref[1]) <= threshold &&
+           std::abs(g * p[2] - ref[2]) <= threshold;
+}
+
+// Colour agreement of one voxel over its views (K&S's consistency check). Samples: the voxel's
+// centre pixel, and with patchStep > 0 also the four pixels patchStep away along the image axes
+// (a sparse patch: texture above and below a uniform band still tells a phantom voxel, which
+// sees the texture slide, from a surface voxel). The reference of each sample is the per-channel
+// median over the views; a view agrees when every sample has a pixel in its 3x3 neighbourhood
+// (half-pixel projection, texture aliasing) within `threshold` per channel of the reference,
+// after the pixel's best exposure gain within kExposureTolerance. Consistent when at least
+// minAgreement of the views agree.
 bool consistent(const std::vector<Point>& px, const std::vector<const Mat*>& img, double threshold,
-                double minAgreement, std::vector<float>& scratch)
+                double minAgreement, int patchStep, std::vector<float>& scratch)
 {
     const int n = (int)px.size();
-    float ref[3];
+    const int s = patchStep;
+    const int nk = s > 0 ? 5 : 1;
+    const Point offs[5] = {Point(0, 0), Point(0, -s), Point(0, s), Point(-s, 0), Point(s, 0)};
+    float ref[5][3];
     scratch.resize(n);
-    for (int c = 0; c < 3; c++)
-    {
-        for (int v = 0; v < n; v++)
-            scratch[v] = img[v]->ptr<uchar>(px[v].y)[3 * px[v].x + c];
-        std::nth_element(scratch.begin(), scratch.begin() + n / 2, scratch.end());
-        ref[c] = scratch[n / 2];
-    }
+    for (int k = 0; k < nk; k++)
+        for (int c = 0; c < 3; c++)
+        {
+            for (int v = 0; v < n; v++)
+            {
+                const Point q = px[v] + offs[k];
+                scratch[v] = img[v]->ptr<uchar>(q.y)[3 * q.x + c];
+            }
+            std::nth_element(scratch.begin(), scratch.begin() + n / 2, scratch.end());
+            ref[k][c] = scratch[n / 2];
+        }
     const int need = (int)std::ceil(minAgreement * n - 1e-9);
     int agree = 0;
     for (int v = 0; v < n; v++)
     {
-        bool ok = false;
-        for (int dy = -1; dy <= 1 && !ok; dy++)
+        bool all = true;
+        for (int k = 0; k < nk && all; k++)
         {
-            const uchar* row = img[v]->ptr<uchar>(px[v].y + dy);
-            for (int dx = -1; dx <= 1; dx++)
+            const Point q = px[v] + offs[k];
+            bool ok = false;
+            for (int dy = -1; dy <= 1 && !ok; dy++)
             {
-                const uchar* p = row + 3 * (px[v].x + dx);
-                const double cr = p[0] * ref[0] + p[1] * ref[1] + p[2] * ref[2];
-                const double cc = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
-                double g = cc > 0 ? cr / cc : 1.0;
-                g = std::min(1.0 + kExposureTolerance, std::max(1.0 / (1.0 + kExposureTolerance), g));
-                const double e = std::max(std::abs(g * p[0] - ref[0]),
-                                          std::max(std::abs(g * p[1] - ref[1]),
-                                                   std::abs(g * p[2] - ref[2])));
-                if (e <= threshold)
-                {
-                    ok = true;
-                    break;
-                }
+                const uchar* row = img[v]->ptr<uchar>(q.y + dy) + 3 * q.x;
+                ok = matches(row - 3, ref[k], threshold) || matches(row, ref[k], threshold) ||
+                     matches(row + 3, ref[k], threshold);
             }
+            all = ok;
         }
-        agree += ok;
+        agree += all;
         if (agree >= need)
             return true;
         if (agree + (n - 1 - v) < need)
@@ -266,8 +280,9 @@ int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
                     Point pt;
                     if (!pr.centrePixel(w[0], w[1], w[2], pt))
                         continue;
-                    if (pt.x < 1 || pt.y < 1 || pt.x >= pr.size.width - 1 ||
-                        pt.y >= pr.size.height - 1 || !ov.roi[c].contains(pt))
+                    const int m = p.patchStep + 1;
+                    if (pt.x < m || pt.y < m || pt.x >= pr.size.width - m ||
+                        pt.y >= pr.size.height - m || !ov.roi[c].contains(pt))
                         continue;
                     const double z = pr.Z[0] * w[0] + (pr.Z[1] * w[1] + pr.Z[2] * w[2] + pr.z0);
                     const Point rp = pt - ov.roi[c].tl();
@@ -280,7 +295,7 @@ int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
                 }
                 if ((int)px.size() < p.minViews)
                     continue;
-                carve[q] = !consistent(px, img, p.threshold, p.minAgreement, scratch);
+                carve[q] = !consistent(px, img, p.threshold, p.minAgreement, p.patchStep, scratch);
             }
         };
         if ((int)work.size() >= kMinParallelItems)

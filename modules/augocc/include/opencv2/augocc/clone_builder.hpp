@@ -130,17 +130,22 @@ public:
         /** refine(): a view agrees with a voxel's colour (the per-channel median over the views
         that see it) when a pixel of the 3x3 neighbourhood of the voxel's centre differs from it
         by at most this many grey levels in every channel, after an exposure gain within 10%
-        (default 10; 8-bit frames). Lower carves more. */
+        (default 15; 8-bit frames). Lower carves more. */
         double photoThreshold;
         /** refine(): a voxel is photo-consistent when at least this fraction of the views that
-        see it agree (default 0.8: a voxel goes when more than a fifth of its views contradict
-        it). Higher carves more. */
+        see it agree (default 0.95: a voxel goes when more than 5% of its views contradict it).
+        Higher carves more. */
         double photoMinAgreement;
         //! refine(): a voxel seen in fewer frames than this is kept (no evidence) (default 8).
         int photoMinViews;
         //! refine(): rounds of the six plane sweeps, each with the visibility the last left
         //! (default 1: a second round carved about 1% more on the synthesized scene).
         int photoRounds;
+        /** refine(): 0 compares the voxel's centre pixel only (default); s > 0 also the four
+        pixels s away along the image axes, each against its own median (a sparse patch: carves
+        phantoms in front of uniform bands, but erodes true edges where the patch straddles an
+        occluding contour; measured in doc/clones.md). */
+        int photoPatchStep;
     };
 
     static Ptr<CloneBuilder> create(const Params& params);
