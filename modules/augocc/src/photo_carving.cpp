@@ -256,6 +256,34 @@ int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
         cover[v] = Mat(ov.roi[cams[v]].size(), CV_32F,
                        Scalar(std::numeric_limits<float>::infinity()));
     const double tol = kVisibilityTolVoxels * g.h;
+    // Per view: raw pointers for the inner loop.
+    struct ViewData
+    {
+        const VoxelProjector* proj;
+        Rect roi;
+        int maxX, maxY;
+        const float* cover;
+        size_t coverStep;
+        const float* others;
+        size_t othersStep;
+        const Mat* image;
+    };
+    const int margin = p.patchStep + 1;
+    std::vector<ViewData> views(nv);
+    for (int v = 0; v < nv; v++)
+    {
+        const int c = cams[v];
+        ViewData& vd = views[v];
+        vd.proj = &ov.proj[c];
+        vd.roi = ov.roi[c];
+        vd.maxX = vd.proj->size.width - margin;
+        vd.maxY = vd.proj->size.height - margin;
+        vd.cover = cover[v].ptr<float>();
+        vd.coverStep = cover[v].step1();
+        vd.others = ov.others[c].empty() ? nullptr : ov.others[c].ptr<float>();
+        vd.othersStep = ov.others[c].empty() ? 0 : ov.others[c].step1();
+        vd.image = ov.image[c];
+    }
     const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
     const int n1 = g.dims[a1], n2 = g.dims[a2], np = g.dims[axis];
     std::vector<uchar> mark((size_t)n1 * n2);
@@ -275,23 +303,22 @@ int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
                 img.clear();
                 for (int v = 0; v < nv; v++)
                 {
-                    const int c = cams[v];
-                    const VoxelProjector& pr = ov.proj[c];
+                    const ViewData& vd = views[v];
+                    const VoxelProjector& pr = *vd.proj;
                     Point pt;
                     if (!pr.centrePixel(w[0], w[1], w[2], pt))
                         continue;
-                    const int m = p.patchStep + 1;
-                    if (pt.x < m || pt.y < m || pt.x >= pr.size.width - m ||
-                        pt.y >= pr.size.height - m || !ov.roi[c].contains(pt))
+                    const int x = pt.x - vd.roi.x, y = pt.y - vd.roi.y;
+                    if (pt.x < margin || pt.y < margin || pt.x >= vd.maxX || pt.y >= vd.maxY ||
+                        x < 0 || y < 0 || x >= vd.roi.width || y >= vd.roi.height)
                         continue;
                     const double z = pr.Z[0] * w[0] + (pr.Z[1] * w[1] + pr.Z[2] * w[2] + pr.z0);
-                    const Point rp = pt - ov.roi[c].tl();
-                    if (z > cover[v].at<float>(rp) + tol)
+                    if (z > vd.cover[(size_t)y * vd.coverStep + x] + tol)
                         continue;
-                    if (!ov.others[c].empty() && z > ov.others[c].at<float>(rp) + tol)
+                    if (vd.others && z > vd.others[(size_t)y * vd.othersStep + x] + tol)
                         continue;
                     px.push_back(pt);
-                    img.push_back(ov.image[c]);
+                    img.push_back(vd.image);
                 }
                 if ((int)px.size() < p.minViews)
                     continue;
@@ -463,9 +490,18 @@ std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstruction& rec,
             }
             std::sort(order.begin(), order.end());
             int64 n = 0;
+            std::vector<std::vector<int> > done;
             for (const auto& d : order)
+            {
+                // Two opposite sweeps can share their cameras (all of them, when the camera
+                // moves little): the second would re-check the same voxels with the same views
+                // and carved about 1% more on the synthesized scene, at the cost of a sweep.
+                if (std::find(done.begin(), done.end(), cams[d.second]) != done.end())
+                    continue;
+                done.push_back(cams[d.second]);
                 n += sweep(obj.grid, d.second / 2, d.second % 2 ? 1 : -1, cams[d.second], ov[o],
                            *cov[o], p);
+            }
             if (n > 0)
                 obj.surface = obj.grid.surface();
             carved[names[o]] += n;
