@@ -584,6 +584,25 @@ TEST(Augocc_CloneBuilder, cli_clone_and_matte)
     EXPECT_EQ(runCommand(bin + " clone --reconstruction " + dir + "/rec.yml --masks " + dir +
                          "/masks --out " + dir + "/c4.yml.gz --orientation 1,2", &out), 2);
     EXPECT_NE(out.find("--orientation"), std::string::npos) << out;
+    // --input: photo-consistency carving over the frames (uniform frames: nothing to carve).
+    std::filesystem::create_directories(dir + "/frames");
+    std::filesystem::create_directories(dir + "/few");
+    for (int f = 0; f < 10; f++)
+    {
+        const Mat img(s.rec.imageSize, CV_8UC3, Scalar(80, 100, 120));
+        imwrite(cv::format("%s/frames/%04d.png", dir.c_str(), f), img);
+        if (f < 5)
+            imwrite(cv::format("%s/few/%04d.png", dir.c_str(), f), img);
+    }
+    ASSERT_EQ(runCommand(bin + " --quiet clone --reconstruction " + dir + "/rec.yml --masks " + dir +
+                         "/masks --out " + dir + "/c5.yml.gz --input " + dir + "/frames", &out), 0)
+        << out;
+    EXPECT_EQ(CloneSet::load(dir + "/c5.yml.gz")->voxelCount("tower"),
+              CloneSet::load(dir + "/clones.yml.gz")->voxelCount("tower"));
+    EXPECT_EQ(runCommand(bin + " clone --reconstruction " + dir + "/rec.yml --masks " + dir +
+                         "/masks --out " + dir + "/c6.yml.gz --input " + dir + "/few", &out), 2);
+    EXPECT_NE(out.find("--input"), std::string::npos) << out;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/c6.yml.gz"));
     {
         std::ofstream(dir + "/corrupt.yml.gz") << "not a clones file";
     }
