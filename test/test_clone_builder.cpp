@@ -490,6 +490,8 @@ Mat dinoSilhouette(const Mat& bgr)
 // reference itself (dark shadows make holes the visual hull fills); the bound fails on a wrong
 // camera convention or a broken carve (IoU < 0.5).
 const double kDinoMeanIoU = 0.9;
+// refine() on the dino photographs: held-out IoU gain, measured +0.030, bound at half.
+const double kDinoMinPhotoGain = 0.015;
 
 TEST(Augocc_CloneBuilder, middlebury_dino)
 {
@@ -501,7 +503,7 @@ TEST(Augocc_CloneBuilder, middlebury_dino)
     ASSERT_EQ(n, 16);
     Reconstruction rec;
     rec.model = PERSPECTIVE;
-    std::vector<Mat> sil;
+    std::vector<Mat> sil, images;
     for (int f = 0; f < n; f++)
     {
         std::string name;
@@ -517,6 +519,7 @@ TEST(Augocc_CloneBuilder, middlebury_dino)
         ASSERT_FALSE(img.empty()) << name;
         rec.imageSize = img.size();
         sil.push_back(dinoSilhouette(img));
+        images.push_back(img);
     }
     ObjectMasks masks;
     for (int f = 0; f < n; f += 2)
@@ -548,6 +551,40 @@ TEST(Augocc_CloneBuilder, middlebury_dino)
               << ", held-out views mean IoU " << sum / 8 << " worst " << worst << std::endl;
     EXPECT_GE(keyMin, kKeyFrameMinIoU);
     EXPECT_GE(sum / 8, kDinoMeanIoU);
+    // Photo-consistency carving on real photographs (all 16 views, default parameters): the
+    // concavities the hull fills against the black background go (measured: held-out mean IoU
+    // 0.928 -> 0.958, 3.0M voxels carved; photoMinViews 8 carves nothing here, a sweep has at
+    // most 7 of the 16 cameras). It may not lose against the thresholded silhouettes.
+    {
+        Ptr<CloneBuilder> b = CloneBuilder::create();
+        Ptr<CloneSet> refined = b->build(rec, masks);
+        const int64 carved = b->refine(*refined, rec, images);
+        double rsum = 0, rkeyMin = 1;
+        for (int f = 0; f < n; f++)
+        {
+            Mat matte;
+            refined->render("dino", f, rec.cameras[f], rec.imageSize, matte);
+            const double iou = maskIoU(matte, sil[f]);
+            if (f % 2 == 0)
+                rkeyMin = std::min(rkeyMin, iou);
+            else
+                rsum += iou;
+            if (f == 1)
+            {
+                Mat before, vis;
+                clones->render("dino", f, rec.cameras[f], rec.imageSize, before);
+                vis = images[f].clone();
+                vis.setTo(Scalar(0, 0, 255), before & ~matte);   // carved by refine
+                vis.setTo(Scalar(0, 255, 0), ~before & sil[f]);  // silhouette the hull misses
+                imwrite(tempDir("dino") + "/dino_view1_photo.png", vis);
+            }
+        }
+        std::cout << "middlebury dino, refine: " << carved
+                  << " voxels carved, key frames min IoU " << rkeyMin
+                  << ", held-out views mean IoU " << rsum / 8 << std::endl;
+        EXPECT_GE(rkeyMin, kKeyFrameMinIoU);
+        EXPECT_GE(rsum / 8, sum / 8 + kDinoMinPhotoGain);
+    }
 }
 
 // augocc clone and augocc matte end to end, and their bad-input exits.

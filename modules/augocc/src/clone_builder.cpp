@@ -15,7 +15,7 @@ CloneBuilder::Params::Params()
     : voxelPixels(1.0), maxVoxels((int64)1 << 27), maxEnlargeIterations(20),
       orientation(ORIENT_AUTO), userRotation(0, 0, 0), raysPerPixel(2), patchRule(PATCH_NEAREST),
       occlusionAware(true), trimFraction(0.02), minPoints(4), photoThreshold(15),
-      photoMinAgreement(0.95), photoMinViews(8), photoRounds(1), photoPatchStep(0)
+      photoMinAgreement(0.95), photoMinViews(4), photoRounds(1), photoPatchStep(0)
 {
 }
 

@@ -61,7 +61,7 @@ struct PhotoCarveParams
 {
     double threshold = 15;
     double minAgreement = 0.95;
-    int minViews = 8;
+    int minViews = 4;
     int rounds = 1;
     int patchStep = 0;
 };

@@ -136,7 +136,9 @@ public:
         see it agree (default 0.95: a voxel goes when more than 5% of its views contradict it).
         Higher carves more. */
         double photoMinAgreement;
-        //! refine(): a voxel seen in fewer frames than this is kept (no evidence) (default 8).
+        /** refine(): a voxel seen in fewer frames than this is kept (no evidence) (default 4:
+        with photoMinAgreement 0.95 all four must agree; a sweep over 16 views on a ring, as in
+        Middlebury's dinoSparseRing, has 5 to 7 cameras). */
         int photoMinViews;
         //! refine(): rounds of the six plane sweeps, each with the visibility the last left
         //! (default 1: a second round carved about 1% more on the synthesized scene).
