@@ -207,7 +207,8 @@ void Augocc_CloneBuilder_refine_synth(benchmark::State& state)
         carved = b->refine(set, p.scene.groundTruth, p.scene.frames);
         cpu += processCpuSeconds() - c0;
     }
-    state.counters["cpu_ms_all_threads"] = 1e3 * cpu / std::max<double>(1, (double)state.iterations());
+    state.counters["cpu_ms_all_threads"] =
+        1e3 * cpu / std::max<double>(1, (double)state.iterations());
     state.counters["carved"] = (double)carved;
     if (carved == 0)
         state.SkipWithError("nothing carved");

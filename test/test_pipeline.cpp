@@ -166,21 +166,23 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
                 Mat diff, row;
                 absdiff(result, truth, diff);
                 hconcat(std::vector<Mat>{truth, result, diff * 4}, row);
-                imwrite("/tmp/comp_p" + std::to_string(photo) + "_k" + std::to_string(k) + ".png", row(Rect(100, 100, 1720, 260)));
+                imwrite("/tmp/comp_p" + std::to_string(photo) + "_k" + std::to_string(k) + ".png",
+                        row(Rect(100, 100, 1720, 260)));
                 imwrite("/tmp/truth4.png", truth4);
                 imwrite("/tmp/truth1.png", truth);
             }
         }
-        std::cout << (photo ? "photo-refined" : "silhouettes") << " k=" << k << " within8(vs ss1) " << acc.within / acc.frames
+        std::cout << (photo ? "photo-refined" : "silhouettes") << " k=" << k
+                  << " within8(vs ss1) " << acc.within / acc.frames
                   << " boundary " << acc.boundary / acc.frames << " band(vs ss1) "
                   << acc.band / acc.frames << " within8(vs ss4) " << acc4.within / acc.frames
                   << " band(vs ss4) " << acc4.band / acc.frames << std::endl;
         // Issue 5: >= 99.5% of pixels within 8 grey levels with GT cameras and built clones
-        // (measured 99.91% at k = 1, 99.86% at k = 3; photo-refined 99.92% / 99.87%). The 1 px
-        // boundary target is not met (2.74 px measured, 2.75 px photo-refined: the dome stands
+        // (measured 99.91% at k = 1, 99.86% at k = 3; photo-refined 99.93% / 99.88%). The 1 px
+        // boundary target is not met (2.74 px measured, 2.81 px photo-refined: the dome stands
         // in the L-block's inner corner, whose phantom volume in front of uniform wall bands
         // photo-consistency cannot carve either), so it is reported, not asserted. The band
-        // colour error drops with the photo-refined clones: 11.07 -> 7.06 (vs the 1x truth).
+        // colour error drops with the photo-refined clones: 11.07 -> 5.97 (vs the 1x truth).
         const double kMinWithin = 0.995;
         EXPECT_GE(acc.within / acc.frames, kMinWithin) << "k=" << k;
     }
@@ -241,15 +243,16 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
                 bnd += s.boundaryDistance;
                 n++;
             }
-            std::cout << (useExact == 1 ? "exact" : useExact == 2 ? "built+photo" : "built") << " k=" << k << " r=" << v.r << " eps="
+            std::cout << (useExact == 1 ? "exact" : useExact == 2 ? "built+photo" : "built")
+                      << " k=" << k << " r=" << v.r << " eps="
                       << v.eps << " band(vs ss4) "
                       << band / n << " boundary " << bnd / n << std::endl;
             bandOf.push_back(band / n);
         }
     // Issue 5: soft edges cut the band error by >= 30% against the hard depth test. Met with
     // exact clones (variants 7 vs 8: measured -49%); with built clones the clones' ~1 px outline
-    // error dominates (variants 0 vs 1: -9%; photo-refined, variants 10 vs 11: 15.9 -> 15.2,
-    // -4%, from 20.0 -> 18.2 without), which is reported above, not asserted.
+    // error dominates (variants 0 vs 1: -9%; photo-refined, variants 10 vs 11: 13.98 -> 13.80,
+    // -1%, though hard edges alone drop 19.95 -> 13.98), which is reported, not asserted.
     const double kMaxSoftOverHard = 0.7;
     ASSERT_EQ(bandOf.size(), sizeof(variants) / sizeof(variants[0]));
     EXPECT_LE(bandOf[8], kMaxSoftOverHard * bandOf[7]);

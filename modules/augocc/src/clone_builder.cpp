@@ -889,7 +889,7 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
         CV_Error(Error::StsBadArg, "CloneBuilder::refine: the reconstruction has no camera");
     if (framesArr.empty())
         CV_Error(Error::StsBadArg, "CloneBuilder::refine: no frames");
-    if (!framesArr.isMatVector() && !framesArr.isUMatVector() && !framesArr.isVector())
+    if (!framesArr.isMatVector() && !framesArr.isUMatVector())
         CV_Error(Error::StsBadArg, "CloneBuilder::refine: frames must be a vector of images");
     const int nframes = (int)framesArr.total();
     std::vector<Mat> frames(nframes);
