@@ -171,6 +171,83 @@ void Augocc_CloneSet_render(benchmark::State& state)
 BENCHMARK(Augocc_CloneSet_render)->Name("Augocc_CloneSet/render_matte_depth_640x480")
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
+
+// refine() on the synthesized scene (3 objects, 60 frames at 640x480, GT cameras): the clones are
+// built once; each iteration refines a fresh copy.
+struct RefineProblem
+{
+    SyntheticScene scene;
+    CloneSetImpl built;
+};
+
+const RefineProblem& refineProblem()
+{
+    static RefineProblem p;
+    if (!p.scene.frames.empty())
+        return p;
+    SceneSynthesizer::create()->synthesize(p.scene);
+    Ptr<CloneSet> c = CloneBuilder::create()->build(p.scene.groundTruth, p.scene.keyFrameMasks,
+                                                    &p.scene.tracks);
+    p.built = dynamic_cast<const CloneSetImpl&>(*c);
+    return p;
+}
+
+void Augocc_CloneBuilder_refine_synth(benchmark::State& state)
+{
+    const RefineProblem& p = refineProblem();
+    Ptr<CloneBuilder> b = CloneBuilder::create();
+    int64 carved = 0;
+    double cpu = 0;
+    for (auto _ : state)
+    {
+        state.PauseTiming();
+        CloneSetImpl set = p.built;
+        const double c0 = processCpuSeconds();
+        state.ResumeTiming();
+        carved = b->refine(set, p.scene.groundTruth, p.scene.frames);
+        cpu += processCpuSeconds() - c0;
+    }
+    state.counters["cpu_ms_all_threads"] =
+        1e3 * cpu / std::max<double>(1, (double)state.iterations());
+    state.counters["carved"] = (double)carved;
+    if (carved == 0)
+        state.SkipWithError("nothing carved");
+}
+BENCHMARK(Augocc_CloneBuilder_refine_synth)
+    ->Name("Augocc_CloneBuilder/refine_synth_3objects_60frames_640x480")
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+// refine() on the 256^3 clone seen by 60 frames around the orbit, every frame one grey: every
+// visible surface voxel is checked against all its views and found consistent (the cost of the
+// visibility and consistency checks of a 256^3 surface; nothing is carved).
+void Augocc_CloneBuilder_refine_256(benchmark::State& state)
+{
+    const CloneProblem& p = problem();
+    const CloneSetImpl& base = dynamic_cast<const CloneSetImpl&>(*p.clones);
+    Reconstruction rec = p.rec;
+    std::vector<Mat> frames;
+    for (int f = 8; f < 60; f++)
+        rec.cameras.push_back(orbit(-35 + 70.0 * (f - 8) / 51, 22, f));
+    for (int f = 0; f < 60; f++)
+    {
+        frames.push_back(Mat(rec.imageSize, CV_8UC3, Scalar(90, 110, 130)));
+    }
+    Ptr<CloneBuilder> b = CloneBuilder::create();
+    int64 carved = 0;
+    for (auto _ : state)
+    {
+        state.PauseTiming();
+        CloneSetImpl set = base;
+        state.ResumeTiming();
+        carved = b->refine(set, rec, frames);
+    }
+    state.counters["carved"] = (double)carved;
+    state.counters["grid_voxels"] = (double)base.objects.at("block").grid.total();
+}
+BENCHMARK(Augocc_CloneBuilder_refine_256)
+    ->Name("Augocc_CloneBuilder/refine_256_60frames_640x480_consistent")
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
 std::string tmpPath(const char* name)
 {
     return cv::format("/tmp/augocc_perf_%d_%s", (int)getpid(), name);

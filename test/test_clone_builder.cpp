@@ -490,6 +490,8 @@ Mat dinoSilhouette(const Mat& bgr)
 // reference itself (dark shadows make holes the visual hull fills); the bound fails on a wrong
 // camera convention or a broken carve (IoU < 0.5).
 const double kDinoMeanIoU = 0.9;
+// refine() on the dino photographs: held-out IoU gain, measured +0.030, bound at half.
+const double kDinoMinPhotoGain = 0.015;
 
 TEST(Augocc_CloneBuilder, middlebury_dino)
 {
@@ -501,7 +503,7 @@ TEST(Augocc_CloneBuilder, middlebury_dino)
     ASSERT_EQ(n, 16);
     Reconstruction rec;
     rec.model = PERSPECTIVE;
-    std::vector<Mat> sil;
+    std::vector<Mat> sil, images;
     for (int f = 0; f < n; f++)
     {
         std::string name;
@@ -517,6 +519,7 @@ TEST(Augocc_CloneBuilder, middlebury_dino)
         ASSERT_FALSE(img.empty()) << name;
         rec.imageSize = img.size();
         sil.push_back(dinoSilhouette(img));
+        images.push_back(img);
     }
     ObjectMasks masks;
     for (int f = 0; f < n; f += 2)
@@ -548,6 +551,40 @@ TEST(Augocc_CloneBuilder, middlebury_dino)
               << ", held-out views mean IoU " << sum / 8 << " worst " << worst << std::endl;
     EXPECT_GE(keyMin, kKeyFrameMinIoU);
     EXPECT_GE(sum / 8, kDinoMeanIoU);
+    // Photo-consistency carving on real photographs (all 16 views, default parameters): the
+    // concavities the hull fills against the black background go (measured: held-out mean IoU
+    // 0.928 -> 0.958, 3.0M voxels carved; photoMinViews 8 carves nothing here, a sweep has at
+    // most 7 of the 16 cameras). It may not lose against the thresholded silhouettes.
+    {
+        Ptr<CloneBuilder> b = CloneBuilder::create();
+        Ptr<CloneSet> refined = b->build(rec, masks);
+        const int64 carved = b->refine(*refined, rec, images);
+        double rsum = 0, rkeyMin = 1;
+        for (int f = 0; f < n; f++)
+        {
+            Mat matte;
+            refined->render("dino", f, rec.cameras[f], rec.imageSize, matte);
+            const double iou = maskIoU(matte, sil[f]);
+            if (f % 2 == 0)
+                rkeyMin = std::min(rkeyMin, iou);
+            else
+                rsum += iou;
+            if (f == 1)
+            {
+                Mat before, vis;
+                clones->render("dino", f, rec.cameras[f], rec.imageSize, before);
+                vis = images[f].clone();
+                vis.setTo(Scalar(0, 0, 255), before & ~matte);   // carved by refine
+                vis.setTo(Scalar(0, 255, 0), ~before & sil[f]);  // silhouette the hull misses
+                imwrite(tempDir("dino") + "/dino_view1_photo.png", vis);
+            }
+        }
+        std::cout << "middlebury dino, refine: " << carved
+                  << " voxels carved, key frames min IoU " << rkeyMin
+                  << ", held-out views mean IoU " << rsum / 8 << std::endl;
+        EXPECT_GE(rkeyMin, kKeyFrameMinIoU);
+        EXPECT_GE(rsum / 8, sum / 8 + kDinoMinPhotoGain);
+    }
 }
 
 // augocc clone and augocc matte end to end, and their bad-input exits.
@@ -584,6 +621,25 @@ TEST(Augocc_CloneBuilder, cli_clone_and_matte)
     EXPECT_EQ(runCommand(bin + " clone --reconstruction " + dir + "/rec.yml --masks " + dir +
                          "/masks --out " + dir + "/c4.yml.gz --orientation 1,2", &out), 2);
     EXPECT_NE(out.find("--orientation"), std::string::npos) << out;
+    // --input: photo-consistency carving over the frames (uniform frames: nothing to carve).
+    std::filesystem::create_directories(dir + "/frames");
+    std::filesystem::create_directories(dir + "/few");
+    for (int f = 0; f < 10; f++)
+    {
+        const Mat img(s.rec.imageSize, CV_8UC3, Scalar(80, 100, 120));
+        imwrite(cv::format("%s/frames/%04d.png", dir.c_str(), f), img);
+        if (f < 5)
+            imwrite(cv::format("%s/few/%04d.png", dir.c_str(), f), img);
+    }
+    ASSERT_EQ(runCommand(bin + " --quiet clone --reconstruction " + dir + "/rec.yml --masks " + dir +
+                         "/masks --out " + dir + "/c5.yml.gz --input " + dir + "/frames", &out), 0)
+        << out;
+    EXPECT_EQ(CloneSet::load(dir + "/c5.yml.gz")->voxelCount("tower"),
+              CloneSet::load(dir + "/clones.yml.gz")->voxelCount("tower"));
+    EXPECT_EQ(runCommand(bin + " clone --reconstruction " + dir + "/rec.yml --masks " + dir +
+                         "/masks --out " + dir + "/c6.yml.gz --input " + dir + "/few", &out), 2);
+    EXPECT_NE(out.find("--input"), std::string::npos) << out;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/c6.yml.gz"));
     {
         std::ofstream(dir + "/corrupt.yml.gz") << "not a clones file";
     }
@@ -772,6 +828,256 @@ TEST(Augocc_CloneBuilder, accuracy_sfm_cameras)
         EXPECT_GE(keyMin, kKeyFrameMinIoU) << name;
         EXPECT_GE(visSum / n, kSfmMeanIoU) << name;
     }
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+
+using namespace cv;
+using namespace cv::augocc;
+
+// Depth of a clone against the truth where the object is seen and the matte covers it: mean
+// |dz| in voxel edges, and the fraction of those pixels where the clone is more than 3 voxels in
+// front of the true surface (the visual hull's phantom volume, which hides virtual objects).
+struct DepthFigures
+{
+    double meanAbs = 0, front = 0;
+};
+
+DepthFigures measureDepth(const CloneSet& clones, const SyntheticScene& s, const String& name,
+                          const String& debugPng = String())
+{
+    DepthFigures fig;
+    int64 n = 0;
+    const double h = clones.voxelSize(name);
+    for (const Camera& cam : s.groundTruth.cameras)
+    {
+        Mat mt, dp;
+        clones.render(name, cam.frame, cam, s.groundTruth.imageSize, mt, dp);
+        const Mat& vis = s.visibleMasks.at(name).at(cam.frame);
+        const Mat& gt = s.depth[cam.frame];
+        Mat dbg;
+        if (!debugPng.empty() && cam.frame == 30)
+            dbg = s.frames[cam.frame] / 3;
+        for (int y = 0; y < dp.rows; y++)
+            for (int x = 0; x < dp.cols; x++)
+                if (vis.at<uchar>(y, x) && mt.at<uchar>(y, x))
+                {
+                    const double dz = (gt.at<float>(y, x) - dp.at<float>(y, x)) / h;
+                    fig.meanAbs += std::abs(dz);
+                    fig.front += dz > 3;
+                    n++;
+                    if (!dbg.empty())  // yellow: clone in front, blue: behind, 4 levels a voxel
+                    {
+                        const int c = (int)std::min(255.0, std::abs(dz) * 4);
+                        dbg.at<Vec3b>(y, x) = dz > 0 ? Vec3b(0, (uchar)c, (uchar)std::max(60, c))
+                                                     : Vec3b((uchar)std::max(60, c), (uchar)c, 0);
+                    }
+                }
+        if (!dbg.empty())
+            imwrite(debugPng, dbg);
+    }
+    fig.meanAbs /= std::max<int64>(n, 1);
+    fig.front /= std::max<int64>(n, 1);
+    return fig;
+}
+
+void printPhoto(const char* tag, const String& name, const SynthFigures& f, const DepthFigures& d)
+{
+    std::cout << tag << " " << name << ": key min IoU " << f.keyMin << ", non-key mean IoU "
+              << f.nonKeyMean << " worst " << f.nonKeyMin << ", boundary " << f.boundary
+              << " px, recall " << f.recall << ", depth: mean |dz| " << d.meanAbs
+              << " voxels, " << d.front * 100 << "% of pixels > 3 voxels in front" << std::endl;
+}
+
+// Photo-consistency carving on the synthesized scene (GT cameras, all 60 frames), figures before
+// and after refine() with the default parameters (orthographic; measured on 2026-11-30):
+//   building: non-key IoU 0.9878 -> 0.9899, recall 0.99941 -> 0.99867, |dz| 6.97 -> 6.15 voxels
+//   lblock:   non-key IoU 0.9718 -> 0.9730, recall 0.99906 -> 0.99895, |dz| 42.4 -> 35.4 voxels
+//   tower:    non-key IoU 0.9592 -> 0.9610, recall 0.99698 -> 0.99694, |dz| 14.4 -> 13.9 voxels
+// The phantom volume in front of uniform walls and roofs stays: views spread along the orbit see
+// the same colour there (a photo-consistency limit, not a tuning one).
+// Key frames stay exact (the carving never uncovers a key-frame silhouette pixel).
+const double kPhotoMaxRecallLoss = 0.002;  // measured 0.0007 (building), budget 3x
+const double kPhotoMinIoUGain = 0.0005;    // measured +0.0012..+0.0021 per object, bound /2
+const double kPhotoLblockDepthRatio = 0.92; // measured 35.4 / 42.4 = 0.83, bound + margin
+
+TEST(Augocc_CloneBuilder_Photo, accuracy_synth)
+{
+    SyntheticScene s;
+    SceneSynthesizer::create()->synthesize(s);
+    Ptr<CloneBuilder> b = CloneBuilder::create();
+    Ptr<CloneSet> clones = b->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+    std::map<String, SynthFigures> before;
+    std::map<String, DepthFigures> beforeDepth;
+    for (const String& name : clones->objectNames())
+    {
+        before[name] = measureSynth(*clones, s, name);
+        beforeDepth[name] = measureDepth(*clones, s, name);
+        printPhoto("before", name, before[name], beforeDepth[name]);
+    }
+    const int64 t0 = getTickCount();
+    const int64 carved = b->refine(*clones, s.groundTruth, s.frames);
+    std::cout << "refine: " << carved << " voxels carved in "
+              << (getTickCount() - t0) * 1000.0 / getTickFrequency() << " ms" << std::endl;
+    EXPECT_GT(carved, 0);
+    for (const String& name : clones->objectNames())
+    {
+        const SynthFigures f = measureSynth(*clones, s, name);
+        const DepthFigures d = measureDepth(*clones, s, name);
+        printPhoto("after ", name, f, d);
+        EXPECT_GE(f.keyMin, kKeyFrameMinIoU) << name;
+        EXPECT_GE(f.recall, before[name].recall - kPhotoMaxRecallLoss) << name;
+        EXPECT_GE(f.nonKeyMean, before[name].nonKeyMean + kPhotoMinIoUGain) << name;
+        EXPECT_LT(d.meanAbs, beforeDepth[name].meanAbs) << name;
+        EXPECT_LT(d.front, beforeDepth[name].front) << name;
+        if (name == "lblock")
+        {
+            EXPECT_LE(d.meanAbs, kPhotoLblockDepthRatio * beforeDepth[name].meanAbs);
+        }
+    }
+}
+
+// Figures and debug images (/tmp/photo_*.png: matte errors before | after, red = matte outside
+// the truth, green = truth missed; depth errors) for both camera models and a parameter set from
+// the environment (AUGOCC_PHOTO_T, _A, _PATCH).
+TEST(Augocc_CloneBuilder_Photo, DISABLED_experiment)
+{
+    for (CameraModel model : {SCALED_ORTHOGRAPHIC, PERSPECTIVE})
+    {
+        SceneSynthesizer::Params sp;
+        sp.model = model;
+        SyntheticScene s;
+        SceneSynthesizer::create(sp)->synthesize(s);
+        CloneBuilder::Params p;
+        if (getenv("AUGOCC_PHOTO_T"))
+            p.photoThreshold = atof(getenv("AUGOCC_PHOTO_T"));
+        if (getenv("AUGOCC_PHOTO_A"))
+            p.photoMinAgreement = atof(getenv("AUGOCC_PHOTO_A"));
+        if (getenv("AUGOCC_PHOTO_PATCH"))
+            p.photoPatchStep = atoi(getenv("AUGOCC_PHOTO_PATCH"));
+        Ptr<CloneBuilder> b = CloneBuilder::create(p);
+        Ptr<CloneSet> clones = b->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+        const String m = cameraModelName(model);
+        for (const String& name : clones->objectNames())
+            printPhoto(("before " + m).c_str(), name, measureSynth(*clones, s, name),
+                       measureDepth(*clones, s, name, "/tmp/photo_depth_" + name + ".png"));
+        ObjectMasks m0;
+        renderMattes(*clones, s.groundTruth, m0);
+        const int64 t0 = getTickCount();
+        const int64 n = b->refine(*clones, s.groundTruth, s.frames);
+        std::cout << "refine: " << n << " voxels carved in "
+                  << (getTickCount() - t0) * 1000.0 / getTickFrequency() << " ms" << std::endl;
+        for (const String& name : clones->objectNames())
+            printPhoto(("after  " + m).c_str(), name, measureSynth(*clones, s, name),
+                       measureDepth(*clones, s, name, "/tmp/photo_depth_" + name + "_after.png"));
+        ObjectMasks m1;
+        renderMattes(*clones, s.groundTruth, m1);
+        for (int f : {5, 30, 50})
+            for (const String& name : clones->objectNames())
+            {
+                Mat img[2];
+                const Mat& whole = s.wholeMasks.at(name).at(f);
+                const Mat* mm[2] = {&m0[name][f], &m1[name][f]};
+                for (int q = 0; q < 2; q++)
+                {
+                    img[q] = s.frames[f] / 2;
+                    img[q].setTo(Scalar(0, 0, 255), *mm[q] & ~whole);
+                    img[q].setTo(Scalar(0, 255, 0), whole & ~*mm[q]);
+                }
+                Mat both;
+                hconcat(img[0], img[1], both);
+                imwrite(cv::format("/tmp/photo_%s_%02d.png", name.c_str(), f), both);
+            }
+    }
+}
+
+TEST(Augocc_CloneBuilder_Photo, multithread_reproducibility)
+{
+    SceneSynthesizer::Params sp;
+    sp.model = PERSPECTIVE;  // the perspective sweep test; the accuracy test is orthographic
+    sp.frames = 16;
+    sp.imageSize = Size(320, 240);
+    sp.numKeyFrames = 4;
+    SyntheticScene s;
+    SceneSynthesizer::create(sp)->synthesize(s);
+    Ptr<CloneBuilder> b = CloneBuilder::create();
+    const int threads = getNumThreads();
+    Ptr<CloneSet> sets[2];
+    int64 carved[2];
+    for (int q = 0; q < 2; q++)
+    {
+        // Many threads first: under TBB a later request above an earlier limit is ignored.
+        setNumThreads(q == 0 ? std::max(threads, 4) : 1);
+        sets[q] = b->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+        carved[q] = b->refine(*sets[q], s.groundTruth, s.frames);
+    }
+    setNumThreads(threads);
+    EXPECT_GT(carved[0], 0);
+    EXPECT_EQ(carved[0], carved[1]);
+    for (const String& name : sets[0]->objectNames())
+    {
+        EXPECT_EQ(sets[0]->voxelCount(name), sets[1]->voxelCount(name)) << name;
+        for (int k : sets[0]->keyFrames(name))
+            EXPECT_EQ(sets[0]->patchVoxelCount(name, k), sets[1]->patchVoxelCount(name, k));
+        for (const Camera& cam : s.groundTruth.cameras)
+        {
+            Mat m0, m1, d0, d1;
+            sets[0]->render(name, cam.frame, cam, s.groundTruth.imageSize, m0, d0);
+            sets[1]->render(name, cam.frame, cam, s.groundTruth.imageSize, m1, d1);
+            EXPECT_EQ(countNonZero(m0 != m1), 0) << name << " frame " << cam.frame;
+            EXPECT_EQ(countNonZero(d0 != d1), 0) << name << " frame " << cam.frame;
+        }
+    }
+}
+
+TEST(Augocc_CloneBuilder_Photo, bad_arg)
+{
+    const AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, towerAndEll(), 6, 3);
+    Ptr<CloneBuilder> b = CloneBuilder::create();
+    Ptr<CloneSet> clones = b->build(s.rec, s.keyMasks);
+    const Size size = s.rec.imageSize;
+    std::vector<Mat> good(6);
+    for (Mat& m : good)
+        m = Mat(size, CV_8UC3, Scalar(90, 120, 60));
+    auto throwsNaming = [&](const std::vector<Mat>& frames, const std::string& what) {
+        try
+        {
+            b->refine(*clones, s.rec, frames);
+        }
+        catch (const cv::Exception& e)
+        {
+            return e.msg.find(what) != std::string::npos
+                       ? ::testing::AssertionSuccess()
+                       : ::testing::AssertionFailure() << "message: " << e.msg;
+        }
+        return ::testing::AssertionFailure() << "no exception";
+    };
+    EXPECT_TRUE(throwsNaming(std::vector<Mat>(), "no frames"));
+    EXPECT_TRUE(throwsNaming(std::vector<Mat>(good.begin(), good.begin() + 4),
+                             "camera for frame 4 but 4 frames"));
+    std::vector<Mat> f = good;
+    f[2] = Mat();
+    EXPECT_TRUE(throwsNaming(f, "frame 2 is empty"));
+    f = good;
+    f[3] = Mat(size.height / 2, size.width, CV_8UC3, Scalar::all(0));
+    EXPECT_TRUE(throwsNaming(f, "frame 3 is"));
+    f = good;
+    f[1] = Mat(size, CV_32FC3, Scalar::all(0));
+    EXPECT_TRUE(throwsNaming(f, "frame 1 must be CV_8UC3"));
+    CloneBuilder::Params p;
+    p.photoMinAgreement = 0;
+    EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
+    p = CloneBuilder::Params();
+    p.photoMinViews = 1;
+    EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
+    // Uniform frames: every voxel is consistent, nothing is carved and the clone is unchanged.
+    const int before = clones->voxelCount("tower");
+    EXPECT_EQ(b->refine(*clones, s.rec, good), 0);
+    EXPECT_EQ(clones->voxelCount("tower"), before);
 }
 
 } // namespace

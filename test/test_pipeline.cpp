@@ -120,10 +120,17 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
     SyntheticScene scene;
     synth->synthesize(scene);
-    Ptr<CloneSet> clones = CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks);
-    const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth, clones.get());
+    Ptr<CloneBuilder> builder = CloneBuilder::create();
+    Ptr<CloneSet> silhouetteClones = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth,
+                                                silhouetteClones.get());
+    // Clones from the silhouettes alone, then carved further by photo-consistency.
+    Ptr<CloneSet> photoClones = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    builder->refine(*photoClones, scene.groundTruth, scene.frames);
+    for (int photo : {0, 1})
     for (int k : {1, 3})
     {
+        const Ptr<CloneSet>& clones = photo ? photoClones : silhouetteClones;
         Compositor::Params cp;
         cp.supersample = k;
         Ptr<Compositor> comp = Compositor::create(cp);
@@ -156,19 +163,26 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
             acc.frames++;
             if (f == 15)
             {
-                imwrite("/tmp/comp_k" + std::to_string(k) + ".png", result);
+                Mat diff, row;
+                absdiff(result, truth, diff);
+                hconcat(std::vector<Mat>{truth, result, diff * 4}, row);
+                imwrite("/tmp/comp_p" + std::to_string(photo) + "_k" + std::to_string(k) + ".png",
+                        row(Rect(100, 100, 1720, 260)));
                 imwrite("/tmp/truth4.png", truth4);
                 imwrite("/tmp/truth1.png", truth);
             }
         }
-        std::cout << "k=" << k << " within8(vs ss1) " << acc.within / acc.frames
+        std::cout << (photo ? "photo-refined" : "silhouettes") << " k=" << k
+                  << " within8(vs ss1) " << acc.within / acc.frames
                   << " boundary " << acc.boundary / acc.frames << " band(vs ss1) "
                   << acc.band / acc.frames << " within8(vs ss4) " << acc4.within / acc.frames
                   << " band(vs ss4) " << acc4.band / acc.frames << std::endl;
         // Issue 5: >= 99.5% of pixels within 8 grey levels with GT cameras and built clones
-        // (measured 99.91% at k = 1, 99.86% at k = 3). The 1 px boundary target is not met
-        // (2.74 px measured: the dome stands in the L-block's inner corner, which the
-        // silhouettes cannot carve), so it is reported, not asserted.
+        // (measured 99.91% at k = 1, 99.86% at k = 3; photo-refined 99.93% / 99.88%). The 1 px
+        // boundary target is not met (2.74 px measured, 2.81 px photo-refined: the dome stands
+        // in the L-block's inner corner, whose phantom volume in front of uniform wall bands
+        // photo-consistency cannot carve either), so it is reported, not asserted. The band
+        // colour error drops with the photo-refined clones: 11.07 -> 5.97 (vs the 1x truth).
         const double kMinWithin = 0.995;
         EXPECT_GE(acc.within / acc.frames, kMinWithin) << "k=" << k;
     }
@@ -182,7 +196,10 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
     SyntheticScene scene;
     synth->synthesize(scene);
-    Ptr<CloneSet> built = CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks);
+    Ptr<CloneBuilder> builder = CloneBuilder::create();
+    Ptr<CloneSet> built = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    Ptr<CloneSet> refined = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    builder->refine(*refined, scene.groundTruth, scene.frames);
     MeshClones exact(scene.objectNames, scene.objectMeshes);
     const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth, built.get());
     Compositor::Params hp;
@@ -192,7 +209,7 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
     struct V { int exact, k, r; double eps; };
     const V variants[] = {{0, 1, 0, 1e-3}, {0, 3, 0, 1e-3}, {0, 1, 2, 1e-3}, {0, 3, 2, 1e-3},
                           {0, 3, 3, 1e-3}, {0, 3, 2, 1e-2}, {0, 3, 2, 1e-4}, {1, 1, 0, 1e-3},
-                          {1, 3, 0, 1e-3}, {1, 3, 2, 1e-3}};
+                          {1, 3, 0, 1e-3}, {1, 3, 2, 1e-3}, {2, 1, 0, 1e-3}, {2, 3, 0, 1e-3}};
     std::vector<double> bandOf;
     for (const V& v : variants)
         {
@@ -211,8 +228,9 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
                 Mat bg, truth4, result, layer, refImg, refLayer, silImg, silLayer;
                 synth->renderWithVirtual(f, {}, bg, 4);
                 synth->renderWithVirtual(f, meshes, truth4, 4);
-                comp->composite(bg, f, cam, useExact ? (const CloneSet&)exact : *built, result,
-                                layer);
+                const CloneSet& clones = useExact == 1 ? (const CloneSet&)exact
+                                         : useExact == 2 ? *refined : *built;
+                comp->composite(bg, f, cam, clones, result, layer);
                 ref->composite(bg, cam, realDepth(scene, f), refImg, refLayer);
                 ref->composite(bg, cam, noArray(), silImg, silLayer);
                 std::vector<Mat> ch, rch, sch;
@@ -225,14 +243,16 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
                 bnd += s.boundaryDistance;
                 n++;
             }
-            std::cout << (useExact ? "exact" : "built") << " k=" << k << " r=" << v.r << " eps="
+            std::cout << (useExact == 1 ? "exact" : useExact == 2 ? "built+photo" : "built")
+                      << " k=" << k << " r=" << v.r << " eps="
                       << v.eps << " band(vs ss4) "
                       << band / n << " boundary " << bnd / n << std::endl;
             bandOf.push_back(band / n);
         }
     // Issue 5: soft edges cut the band error by >= 30% against the hard depth test. Met with
     // exact clones (variants 7 vs 8: measured -49%); with built clones the clones' ~1 px outline
-    // error dominates (variants 0 vs 1: -6%), which is reported above, not asserted.
+    // error dominates (variants 0 vs 1: -9%; photo-refined, variants 10 vs 11: 13.98 -> 13.80,
+    // -1%, though hard edges alone drop 19.95 -> 13.98), which is reported, not asserted.
     const double kMaxSoftOverHard = 0.7;
     ASSERT_EQ(bandOf.size(), sizeof(variants) / sizeof(variants[0]));
     EXPECT_LE(bandOf[8], kMaxSoftOverHard * bandOf[7]);

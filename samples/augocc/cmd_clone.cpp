@@ -12,7 +12,8 @@ namespace {
 
 struct CloneOptions
 {
-    std::string reconstruction, masks, out, tracks, orientation, ply, patchRule = "nearest";
+    std::string reconstruction, masks, out, tracks, orientation, ply, input,
+        patchRule = "nearest";
     double voxelPixels = 1.0;
     int raysPerPixel = 2;
     bool noOcclusion = false;
@@ -35,6 +36,8 @@ void runClone(const CloneOptions& o, const Globals& g)
     requireFile("--masks", o.masks);
     if (!o.tracks.empty())
         requireFile("--tracks", o.tracks);
+    if (!o.input.empty() && o.input.find('%') == std::string::npos)
+        requireFile("--input", o.input);
     CloneBuilder::Params p;
     p.voxelPixels = o.voxelPixels;
     p.raysPerPixel = o.raysPerPixel;
@@ -55,9 +58,36 @@ void runClone(const CloneOptions& o, const Globals& g)
     Tracks tracks;
     if (!o.tracks.empty())
         tracks = readTracks(o.tracks);
+    std::vector<cv::Mat> frames;
+    if (!o.input.empty())
+    {
+        // Every frame with a camera, for the photo-consistency carving.
+        cv::Ptr<FrameSource> src = FrameSource::open(o.input);
+        if (src->size() != rec.imageSize)
+            throw UsageError("--input " + o.input + cv::format(": frames are %dx%d, the "
+                             "reconstruction's %dx%d", src->size().width, src->size().height,
+                             rec.imageSize.width, rec.imageSize.height));
+        for (const Camera& cam : rec.cameras)
+            if (cam.frame >= src->count())
+                throw UsageError("--input " + o.input + cv::format(": %d frames, but the "
+                                 "reconstruction has a camera for frame %d", src->count(),
+                                 cam.frame));
+        frames.resize(src->count());
+        for (int f = 0; f < src->count(); f++)
+        {
+            cv::Mat img;
+            if (!src->read(img))
+                throw UsageError("--input " + o.input + cv::format(": frame %d cannot be read",
+                                                                   f));
+            if (rec.findCamera(f) >= 0)
+                frames[f] = img;
+        }
+    }
     Progress progress(g, "clone", 1);
-    cv::Ptr<CloneSet> clones = CloneBuilder::create(p)->build(rec, masks,
-                                                              o.tracks.empty() ? nullptr : &tracks);
+    cv::Ptr<CloneBuilder> builder = CloneBuilder::create(p);
+    cv::Ptr<CloneSet> clones = builder->build(rec, masks, o.tracks.empty() ? nullptr : &tracks);
+    if (!frames.empty())
+        builder->refine(*clones, rec, frames);
     progress.finish();
     clones->save(o.out);
     if (!o.ply.empty())
@@ -87,6 +117,8 @@ void registerClone(CLI::App& app, Globals& g)
                     "the frames where they are seen)");
     sub->add_option("--orientation", o->orientation, "box rotation rx,ry,rz in degrees "
                     "(Rodrigues); default: automatic");
+    sub->add_option("--input", o->input, "the video (or image folder, printf pattern): carve the "
+                    "clones further by photo-consistency over every frame with a camera");
     sub->add_option("--ply", o->ply, "also write PLY files of each clone and patch set here");
     sub->add_option("--voxel-pixels", o->voxelPixels, "voxel edge in pixels (default 1)");
     sub->add_option("--rays-per-pixel", o->raysPerPixel, "patch rays per pixel along each axis "

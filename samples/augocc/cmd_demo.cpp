@@ -17,12 +17,16 @@ std::function<void(const String&, int, int)> stageProgress(const Globals& g,
 void registerDemo(CLI::App& app, Globals& g)
 {
     auto outDir = std::make_shared<std::string>("augocc_demo");
+    auto noPhoto = std::make_shared<bool>(false);
     CLI::App* sub = app.add_subcommand("demo", "synthesize a scene and run the whole pipeline "
                                        "on it (no input needed)");
     sub->add_option("--out-dir", *outDir, "output folder (default augocc_demo)");
-    sub->callback([&g, outDir]() {
+    sub->add_flag("--no-photo-refine", *noPhoto, "clones from the silhouettes alone (no "
+                  "photo-consistency carving over the frames)");
+    sub->callback([&g, outDir, noPhoto]() {
         DemoOptions o;
         o.outDir = *outDir;
+        o.photoRefine = !*noPhoto;
         std::shared_ptr<Progress> current;
         auto stage = std::make_shared<std::string>();
         o.progress = stageProgress(g, current, stage);

@@ -14,7 +14,8 @@ namespace augocc {
 CloneBuilder::Params::Params()
     : voxelPixels(1.0), maxVoxels((int64)1 << 27), maxEnlargeIterations(20),
       orientation(ORIENT_AUTO), userRotation(0, 0, 0), raysPerPixel(2), patchRule(PATCH_NEAREST),
-      occlusionAware(true), trimFraction(0.02), minPoints(4)
+      occlusionAware(true), trimFraction(0.02), minPoints(4), photoThreshold(15),
+      photoMinAgreement(0.95), photoMinViews(4), photoRounds(1), photoPatchStep(0)
 {
 }
 
@@ -576,6 +577,16 @@ public:
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::trimFraction must be in [0, 0.5)");
         if (p.minPoints < 1)
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::minPoints must be >= 1");
+        if (!(p.photoThreshold >= 0 && p.photoThreshold <= 255))
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoThreshold must be in [0, 255]");
+        if (!(p.photoMinAgreement > 0 && p.photoMinAgreement <= 1))
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoMinAgreement must be in (0, 1]");
+        if (p.photoMinViews < 2)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoMinViews must be >= 2");
+        if (p.photoRounds < 1)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoRounds must be >= 1");
+        if (p.photoPatchStep < 0 || p.photoPatchStep > 8)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoPatchStep must be in [0, 8]");
         params_ = p;
     }
 
@@ -583,6 +594,8 @@ public:
                         const Tracks* tracks) const CV_OVERRIDE;
     void addKeyFrame(CloneSet& clones, const Reconstruction& rec, const String& object,
                      int frame, InputArray mask) const CV_OVERRIDE;
+    int64 refine(CloneSet& clones, const Reconstruction& rec,
+                 InputArrayOfArrays frames) const CV_OVERRIDE;
 
 private:
     Matx33d orientationFor(const Reconstruction& rec, const std::vector<Vec3d>& pts) const
@@ -723,6 +736,9 @@ int64 dropUnseenVoxels(ObjectClone& obj, const Reconstruction& rec)
     return dropped;
 }
 
+void recomputePatches(std::map<String, ObjectClone>& objs, ObjectClone& obj,
+                      const Reconstruction& rec, bool occlusionAware, int raysPerPixel);
+
 void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
                    const Reconstruction& rec, const std::vector<int>& carveFrames,
                    bool occlusionAware, int raysPerPixel)
@@ -750,7 +766,13 @@ void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
         }
     }
     obj.surface = obj.grid.surface();
-    // Step 5 for every key frame (the clone changed, so every patch set is redone).
+    recomputePatches(objs, obj, rec, occlusionAware, raysPerPixel);
+}
+
+// Step 5 for every key frame (the clone changed, so every patch set is redone).
+void recomputePatches(std::map<String, ObjectClone>& objs, ObjectClone& obj,
+                      const Reconstruction& rec, bool occlusionAware, int raysPerPixel)
+{
     std::vector<int> keys;
     for (const auto& m : obj.masks)
         keys.push_back(m.first);
@@ -854,6 +876,69 @@ void CloneBuilderImpl::addKeyFrame(CloneSet& clones, const Reconstruction& rec,
     obj.masks[frame] = m > 127;
     carveAndPatch(set->objects, obj, rec, std::vector<int>(1, frame), params_.occlusionAware,
                   params_.raysPerPixel);
+}
+
+int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
+                               InputArrayOfArrays framesArr) const
+{
+    CloneSetImpl* set = dynamic_cast<CloneSetImpl*>(&clones);
+    if (!set)
+        CV_Error(Error::StsBadArg, "CloneBuilder::refine: the clone set was not made by "
+                 "CloneBuilder or CloneSet::load");
+    if (rec.cameras.empty())
+        CV_Error(Error::StsBadArg, "CloneBuilder::refine: the reconstruction has no camera");
+    if (framesArr.empty())
+        CV_Error(Error::StsBadArg, "CloneBuilder::refine: no frames");
+    if (!framesArr.isMatVector() && !framesArr.isUMatVector())
+        CV_Error(Error::StsBadArg, "CloneBuilder::refine: frames must be a vector of images");
+    const int nframes = (int)framesArr.total();
+    std::vector<Mat> frames(nframes);
+    for (const Camera& cam : rec.cameras)
+    {
+        const int f = cam.frame;
+        if (f < 0 || f >= nframes)
+            CV_Error(Error::StsBadArg, cv::format("CloneBuilder::refine: the reconstruction has a "
+                     "camera for frame %d but %d frames are given", f, nframes));
+        Mat m = framesArr.getMat(f);
+        if (m.empty())
+            CV_Error(Error::StsBadArg, cv::format("CloneBuilder::refine: frame %d is empty", f));
+        if (m.size() != rec.imageSize)
+            CV_Error(Error::StsBadSize, cv::format("CloneBuilder::refine: frame %d is %dx%d, the "
+                     "reconstruction's image size %dx%d", f, m.cols, m.rows,
+                     rec.imageSize.width, rec.imageSize.height));
+        if (m.type() == CV_8UC1)
+            cvtColor(m, frames[f], COLOR_GRAY2BGR);
+        else if (m.type() == CV_8UC3)
+            frames[f] = m;
+        else
+            CV_Error(Error::StsUnsupportedFormat, cv::format("CloneBuilder::refine: frame %d "
+                     "must be CV_8UC3 or CV_8UC1", f));
+    }
+    for (const auto& o : set->objects)
+        for (const auto& m : o.second.masks)
+            if (m.second.size() != rec.imageSize)
+                CV_Error(Error::StsBadSize, cv::format("CloneBuilder::refine: object '%s': key "
+                         "frame %d's silhouette differs from the reconstruction's image size",
+                         o.first.c_str(), m.first));
+            else if (rec.findCamera(m.first) < 0)
+                CV_Error(Error::StsBadArg, cv::format("CloneBuilder::refine: object '%s': key "
+                         "frame %d has no camera", o.first.c_str(), m.first));
+    PhotoCarveParams pp;
+    pp.threshold = params_.photoThreshold;
+    pp.minAgreement = params_.photoMinAgreement;
+    pp.minViews = params_.photoMinViews;
+    pp.rounds = params_.photoRounds;
+    pp.patchStep = params_.photoPatchStep;
+    const std::map<String, int64> carved = photoCarve(*set, rec, frames, pp);
+    int64 total = 0;
+    for (const auto& c : carved)
+    {
+        total += c.second;
+        if (c.second > 0)
+            recomputePatches(set->objects, set->get(c.first), rec, params_.occlusionAware,
+                             params_.raysPerPixel);
+    }
+    return total;
 }
 
 } // namespace

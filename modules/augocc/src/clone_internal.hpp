@@ -56,6 +56,24 @@ CV_EXPORTS std::vector<uint32_t> computePatches(const ObjectClone& obj, const Ca
                                                 const Mat& silhouette, const Mat& keep,
                                                 int raysPerPixel);
 
+//! Photo-consistency carving parameters (CloneBuilder::Params::photo*).
+struct PhotoCarveParams
+{
+    double threshold = 15;
+    double minAgreement = 0.95;
+    int minViews = 4;
+    int rounds = 1;
+    int patchStep = 0;
+};
+
+/** @brief Space carving by photo-consistency on every frame with a camera (CloneBuilder::refine):
+carves inconsistent surface voxels of every object's grid, never one that a key-frame silhouette
+pixel needs; updates the grids and surfaces (not the patches). `frames[f]` is the BGR image of
+frame f (validated by the caller). Returns the voxels carved per object. */
+CV_EXPORTS std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstruction& rec,
+                                              const std::vector<Mat>& frames,
+                                              const PhotoCarveParams& params);
+
 } // namespace detail
 } // namespace augocc
 } // namespace cv

@@ -548,7 +548,24 @@ RunResult runPipeline(const RunOptions& o)
 
     timer.start();
     progress("clone", 0, 1);
-    r.clones = CloneBuilder::create()->build(r.reconstruction, masks, &r.tracks);
+    Ptr<CloneBuilder> builder = CloneBuilder::create();
+    r.clones = builder->build(r.reconstruction, masks, &r.tracks);
+    if (o.photoRefine)
+    {
+        // Every frame with a camera (the others stay empty; refine() reads only those).
+        std::vector<Mat> frames(frameCount);
+        src->seek(0);
+        for (int f = 0; f < frameCount; f++)
+        {
+            Mat img;
+            if (!src->read(img))
+                CV_Error(Error::StsParseError, o.input + cv::format(": frame %d cannot be read "
+                         "again for the photo-consistency carving", f));
+            if (r.reconstruction.findCamera(f) >= 0)
+                frames[f] = img;
+        }
+        builder->refine(*r.clones, r.reconstruction, frames);
+    }
     r.clones->save((dir / "clones.yml.gz").string());
     progress("clone", 1, 1);
     timer.stop("clone");
@@ -655,6 +672,7 @@ DemoResult runDemo(const DemoOptions& o)
     ro.scenePath = res.scenePath;
     ro.outDir = o.outDir;
     ro.progress = o.progress;
+    ro.photoRefine = o.photoRefine;
     res.run = runPipeline(ro);
     res.compositePath = res.run.compositePath;
 

@@ -127,6 +127,27 @@ public:
         //! Step 1: fewer clustered points than this and the box comes from the silhouettes alone
         //! (default 4).
         int minPoints;
+        /** refine(): a view agrees with a voxel's colour (the per-channel median over the views
+        that see it) when a pixel of the 3x3 neighbourhood of the voxel's centre differs from it
+        by at most this many grey levels in every channel, after an exposure gain within 10%
+        (default 15; 8-bit frames). Lower carves more. */
+        double photoThreshold;
+        /** refine(): a voxel is photo-consistent when at least this fraction of the views that
+        see it agree (default 0.95: a voxel goes when more than 5% of its views contradict it).
+        Higher carves more. */
+        double photoMinAgreement;
+        /** refine(): a voxel seen in fewer frames than this is kept (no evidence) (default 4:
+        with photoMinAgreement 0.95 all four must agree; a sweep over 16 views on a ring, as in
+        Middlebury's dinoSparseRing, has 5 to 7 cameras). */
+        int photoMinViews;
+        //! refine(): rounds of the six plane sweeps, each with the visibility the last left
+        //! (default 1: a second round carved about 1% more on the synthesized scene).
+        int photoRounds;
+        /** refine(): 0 compares the voxel's centre pixel only (default); s > 0 also the four
+        pixels s away along the image axes, each against its own median (a sparse patch: carves
+        phantoms in front of uniform bands, but erodes true edges where the patch straddles an
+        occluding contour; measured in doc/clones.md). */
+        int photoPatchStep;
     };
 
     static Ptr<CloneBuilder> create(const Params& params);
@@ -160,6 +181,28 @@ public:
     */
     virtual void addKeyFrame(CloneSet& clones, const Reconstruction& rec, const String& object,
                              int frame, InputArray mask) const = 0;
+
+    /** @brief Carves the clones beyond the visual hull by photo-consistency over every frame
+    with a camera (space carving @cite Kutulakos2000 with voxel colouring's visibility
+    @cite Seitz1999), then redoes the patch voxels.
+
+    Silhouettes cannot carve concavities (an L-shaped block's inner corner, the space under an
+    overhang). Here plane sweeps along the six grid directions visit the surface voxels front to
+    back for the cameras that look along the sweep; a voxel's colour is gathered from the frames
+    where it is visible (all clones together hide each other, depth tolerance two voxels) and an
+    inconsistent voxel is carved (Params::photoThreshold, photoMinAgreement), which exposes the
+    voxels behind it. Safety: a voxel seen in fewer than Params::photoMinViews frames is kept,
+    and no voxel is carved whose removal would leave a pixel of a key-frame silhouette uncovered
+    by the model (the user's silhouettes are the truth). Deterministic for any thread count.
+    @param clones a set made by build() or CloneSet::load().
+    @param rec the reconstruction: cameras of the frames (only frames with a camera are used).
+    @param frames the video frames, frames[f] is frame f (BGR CV_8UC3, or CV_8UC1), the
+    reconstruction's image size; there must be one for every camera's frame.
+    @return the number of voxels carved, all objects together.
+    Throws StsBadArg / StsBadSize naming the frame for a missing, empty or mis-sized frame.
+    */
+    virtual int64 refine(CloneSet& clones, const Reconstruction& rec,
+                         InputArrayOfArrays frames) const = 0;
 };
 
 /** @brief Renders every object's matte (and optionally depth) in every frame of `rec`.

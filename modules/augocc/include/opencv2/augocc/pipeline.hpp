@@ -118,6 +118,8 @@ struct CV_EXPORTS RunOptions
     String scenePath;        //!< scene.yml; empty: stop after the mattes
     String outDir;           //!< every intermediate file and the composite go here
     int supersample = 3;     //!< compositor supersampling (1: hard edges)
+    //! Carve the clones further by photo-consistency over every frame (CloneBuilder::refine).
+    bool photoRefine = true;
     //! Stage progress: (stage name, done, total); a stage starts with done = 0.
     std::function<void(const String& stage, int done, int total)> progress;
 };
@@ -143,6 +145,7 @@ struct CV_EXPORTS DemoOptions
     String outDir = "augocc_demo";
     int frames = 60;
     Size imageSize = Size(640, 480);
+    bool photoRefine = true;  //!< RunOptions::photoRefine
     std::function<void(const String& stage, int done, int total)> progress;
 };
 
