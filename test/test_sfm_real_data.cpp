@@ -136,6 +136,49 @@ bool readDinoCameras(const std::string& path, Reconstruction& gt)
     return true;
 }
 
+// The rotation of view i relative to view 0, as an unsigned angle (degrees).
+double angleFromFirst(const Reconstruction& rec, int i)
+{
+    const Matx33d D = rec.cameras[i].R * rec.cameras[0].R.t();
+    return std::acos(std::max(-1.0, std::min(1.0, 0.5 * (trace(D) - 1)))) * 180 / CV_PI;
+}
+
+// dino_Ps.txt with the principal point moved to the image centre, the convention of augocc's
+// cameras: each camera turned (minimal rotation) so that its optical axis is its ray through the
+// image centre. dino_Ps' intrinsics are far from a centred square-pixel camera (RQ: fx 3217,
+// fy 2292, principal point (290, -1071) px, 31 degrees from the image centre), and for a
+// turntable (single-axis motion) the camera's tilt against the axis trades with them.
+Reconstruction centredPrincipalPoint(const Reconstruction& gt)
+{
+    Reconstruction c = gt;
+    for (Camera& cam : c.cameras)
+    {
+        const Point2d centre((gt.imageSize.width - 1) * 0.5, (gt.imageSize.height - 1) * 0.5);
+        Vec3d ray = cam.K.inv() * Vec3d(centre.x, centre.y, 1.0);
+        ray /= cv::norm(ray);
+        const Vec3d axis = ray.cross(Vec3d(0, 0, 1));
+        const double sn = cv::norm(axis);
+        Matx33d Ra = Matx33d::eye();
+        if (sn > 0)
+            Rodrigues(axis * (std::atan2(sn, ray[2]) / sn), Ra);
+        cam.R = Ra * cam.R;
+    }
+    return c;
+}
+
+// The cameras over the whole turn. Before the incremental path (factorization_sfm.cpp), the
+// affine alternation bent over the turn: 76.9 deg mean, 178 deg max rotation error against
+// dino_Ps.txt. Now 24.3 deg mean, 24.6 max: a constant offset, the same for every view, which
+// we attribute to dino_Ps' calibration rather than to the method: it is a tilt of the
+// cameras against the turntable axis, which single-axis motion determines poorly and which
+// trades with intrinsics that augocc's cameras do not have (dino_Ps: principal point 31 degrees
+// off the image centre, aspect ratio 1.4). The scaled-orthographic bundle adjustment started
+// from dino_Ps' own rotations drifts to the same 23-25 deg offset (lower cost under the model),
+// the relative rotation angles match (10.0 deg a step), and the same
+// full-turn short-track geometry with a centred principal point is recovered to 0.3 deg
+// (Augocc_SfmSynth.full_turn_short_tracks_perspective). Checked here: the turn angle of every
+// view (invariant to that tilt), the offset staying constant, and the error against dino_Ps
+// with its principal point moved to the image centre.
 TEST(Augocc_SfmRealData, oxford_dinosaur)
 {
     AUGOCC_REQUIRE_SHARED_DATA(path, "oxford_dinosaur/tracks.yml");
@@ -148,39 +191,49 @@ TEST(Augocc_SfmRealData, oxford_dinosaur)
         observed += tracks.observationCount(p);
     const double missing = 1.0 - (double)observed / (tracks.frames() * tracks.points());
     SfmReport rep;
+    const int64 t0 = getTickCount();
     const Reconstruction rec = recoverCameras(tracks, SfmOptions(), &rep);
-    const CameraComparison cmp = compareCameras(rec, gt, rec.model == SCALED_ORTHOGRAPHIC);
+    const double seconds = (getTickCount() - t0) / getTickFrequency();
+    const bool ortho = rec.model == SCALED_ORTHOGRAPHIC;
+    const CameraComparison cmp = compareCameras(rec, gt, ortho);
+    const CameraComparison centred = compareCameras(rec, centredPrincipalPoint(gt), ortho);
     const ReprojectionStats& st = rep.chosenModel == "perspective" ? rep.perspective
                                                                    : rep.orthographic;
+    ASSERT_EQ(36, (int)rec.cameras.size());
+    double turnMean = 0, turnMax = 0;
+    for (int i = 1; i < 36; i++)
+    {
+        ASSERT_EQ(i, rec.cameras[i].frame);
+        const double e = std::abs(angleFromFirst(rec, i) - angleFromFirst(gt, i));
+        turnMean += e / 35;
+        turnMax = std::max(turnMax, e);
+    }
     std::cout << "oxford_dinosaur (" << tracks.frames() << " views, " << tracks.points()
               << " tracks, " << cvRound(100 * missing) << "% missing): " << rec.cameras.size()
-              << " cameras, model " << rep.chosenModel << ", kept " << rep.inlierTracks
-              << " tracks; reprojection median " << st.median << " px, RMS " << st.rms
-              << "; rotation vs dino_Ps.txt: mean " << cmp.meanRotationDeg << " deg, max "
-              << cmp.maxRotationDeg << " deg over " << cmp.frames << " views" << std::endl;
+              << " cameras in " << seconds << " s, model " << rep.chosenModel << ", kept "
+              << rep.inlierTracks << " tracks; reprojection median " << st.median << " px, RMS "
+              << st.rms << "\n  rotation vs dino_Ps.txt: mean " << cmp.meanRotationDeg
+              << " deg, max " << cmp.maxRotationDeg << " deg; vs dino_Ps.txt with a centred "
+              << "principal point: mean " << centred.meanRotationDeg << " deg, max "
+              << centred.maxRotationDeg << " deg\n  turn angle from view 0 vs dino_Ps.txt: "
+              << "error mean " << turnMean << " deg, max " << turnMax << " deg" << std::endl;
     // The sequence must be reconstructed as a whole with a low reprojection error.
-    const int kMinDinoViews = 30;          // most of the 36 views connected
-    const double kMaxDinoMedianPx = 1.0;   // VGG's own cameras: 0.22 px median (SOURCE.txt)
-    EXPECT_GE((int)rec.cameras.size(), kMinDinoViews);
+    const double kMaxDinoMedianPx = 0.3;   // measured 0.20; VGG's own cameras: 0.22 (SOURCE.txt)
+    const double kMaxDinoRmsPx = 0.5;      // measured 0.36 (before the incremental path: 1.73)
     EXPECT_LE(st.median, kMaxDinoMedianPx);
-    // Known weakness (doc/camera_recovery.md): with 3.3 views per track over a full 360 degree
-    // turn, the alternation leaves an affine solution that is only locally consistent and the
-    // cameras drift (mean rotation error about 77 degrees against dino_Ps.txt, although the
-    // reprojection error is low). The camera check below is what a damped-Newton missing-data
-    // solver (Buchanan & Fitzgibbon 2005) should pass; it is kept as a disabled test.
-}
-
-TEST(Augocc_SfmRealData, DISABLED_oxford_dinosaur_cameras)
-{
-    AUGOCC_REQUIRE_SHARED_DATA(path, "oxford_dinosaur/tracks.yml");
-    AUGOCC_REQUIRE_SHARED_DATA(psPath, "oxford_dinosaur/dino_Ps.txt");
-    const Tracks tracks = readTracks(path);
-    Reconstruction gt;
-    ASSERT_TRUE(readDinoCameras(psPath, gt));
-    const Reconstruction rec = recoverCameras(tracks, SfmOptions());
-    const CameraComparison cmp = compareCameras(rec, gt, rec.model == SCALED_ORTHOGRAPHIC);
-    const double kMaxDinoRotDeg = 5.0;     // 10 degrees between views: a gross error is larger
-    EXPECT_LE(cmp.meanRotationDeg, kMaxDinoRotDeg);
+    EXPECT_LE(st.rms, kMaxDinoRmsPx);
+    // The cameras (see above).
+    const double kMaxTurnMeanDeg = 1.0;    // measured 0.41 (10 degrees between views)
+    const double kMaxTurnDeg = 2.0;        // measured 0.60
+    const double kMaxRawMeanDeg = 26.0;    // measured 24.3, the tilt offset above
+    const double kMaxCentredMeanDeg = 8.0; // measured 6.5
+    EXPECT_LE(turnMean, kMaxTurnMeanDeg);
+    EXPECT_LE(turnMax, kMaxTurnDeg);
+    EXPECT_LE(cmp.meanRotationDeg, kMaxRawMeanDeg);
+    EXPECT_LE(centred.meanRotationDeg, kMaxCentredMeanDeg);
+    // A constant offset: the per-view errors spread less than the step between views.
+    const double kMaxOffsetSpreadDeg = 2.0;   // measured 0.3 (24.3 mean, 24.6 max)
+    EXPECT_LE(cmp.maxRotationDeg - cmp.meanRotationDeg, kMaxOffsetSpreadDeg);
 }
 
 } // namespace

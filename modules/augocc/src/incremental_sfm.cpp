@@ -61,6 +61,8 @@ const double kGlobalGrowth = 1.25;
 const int kResectIterations = 20;
 const int kLocalBaIterations = 10;
 const int kGlobalBaIterations = 50;
+// Parameters of one camera in the adjustments: quaternion (4), translation (2), zoom (1).
+const int kCamBlock = 7;
 
 Eigen::Quaterniond toQuaternion(const Matx33d& R)
 {
@@ -414,15 +416,23 @@ void IncrementalBuilder::bundleAdjust(const std::vector<uchar>& variable, int it
             if (solvedPoint(idx_.byFrame[i].point))
                 pointUsed[idx_.byFrame[i].point] = 1;
     }
-    std::vector<Eigen::Quaterniond> q(F);
-    std::vector<Vec2d> t(F);
-    std::vector<double> s(F);
+    // Every camera's blocks in one array, frame by frame (quaternion x y z w, tx ty, s): Ceres
+    // orders the blocks of an elimination group by address, so that the summation order, and
+    // with it the result to the last bit, depends on the layout (separate heap arrays did not
+    // give the same result twice).
+    std::vector<double> cam((size_t)F * kCamBlock, 0.0);
+    auto q = [&](int f) { return &cam[(size_t)f * kCamBlock]; };
+    auto t = [&](int f) { return &cam[(size_t)f * kCamBlock + 4]; };
+    auto s = [&](int f) { return &cam[(size_t)f * kCamBlock + 6]; };
     for (int f = 0; f < F; f++)
         if (views_[f].solved)
         {
-            q[f] = toQuaternion(views_[f].R);
-            t[f] = views_[f].t;
-            s[f] = views_[f].s;
+            const Eigen::Quaterniond qf = toQuaternion(views_[f].R);
+            for (int k = 0; k < 4; k++)
+                q(f)[k] = qf.coeffs()[k];
+            t(f)[0] = views_[f].t[0];
+            t(f)[1] = views_[f].t[1];
+            *s(f) = views_[f].s;
         }
     Mat X = X_.clone();
     std::deque<OrthoReprojectionCost> costs;   // declared before the problem: outlives it
@@ -445,49 +455,87 @@ void IncrementalBuilder::bundleAdjust(const std::vector<uchar>& variable, int it
             if (!views_[o.frame].solved)
                 continue;
             costs.emplace_back(o.u, o.v, pp_.x, pp_.y);
-            problem.AddResidualBlock(&costs.back(), &loss, q[o.frame].coeffs().data(),
-                                     t[o.frame].val, &s[o.frame], X.ptr<double>(p));
+            problem.AddResidualBlock(&costs.back(), &loss, q(o.frame), t(o.frame),
+                                     s(o.frame), X.ptr<double>(p));
             inProblem[o.frame] = 1;
         }
         ordering->AddElementToGroup(X.ptr<double>(p), 0);
     }
     if (problem.NumResidualBlocks() == 0)
         return;
-    bool anyFixed = false;
+    std::vector<Vec3d> fixedDirs;
     int firstVar = -1;
     for (int f = 0; f < F; f++)
     {
         if (!inProblem[f])
             continue;
-        problem.SetManifold(q[f].coeffs().data(), &quatManifold);
-        ordering->AddElementToGroup(q[f].coeffs().data(), 1);
-        ordering->AddElementToGroup(t[f].val, 1);
-        ordering->AddElementToGroup(&s[f], 1);
+        problem.SetManifold(q(f), &quatManifold);
+        ordering->AddElementToGroup(q(f), 1);
+        ordering->AddElementToGroup(t(f), 1);
+        ordering->AddElementToGroup(s(f), 1);
         if (variable[f])
         {
             if (firstVar < 0)
                 firstVar = f;
             continue;
         }
-        anyFixed = true;
-        problem.SetParameterBlockConstant(q[f].coeffs().data());
-        problem.SetParameterBlockConstant(t[f].val);
-        problem.SetParameterBlockConstant(&s[f]);
+        problem.SetParameterBlockConstant(q(f));
+        problem.SetParameterBlockConstant(t(f));
+        problem.SetParameterBlockConstant(s(f));
+        fixedDirs.push_back(Vec3d(views_[f].R(2, 0), views_[f].R(2, 1), views_[f].R(2, 2)));
     }
-    if (!anyFixed && firstVar >= 0)
+    // Gauge (a similarity: 7 degrees of freedom). A fixed frame holds the rotation, the scale and
+    // the translation across its line of sight; two fixed frames with distinct lines of sight
+    // hold everything. Else: without a fixed frame, the first variable frame's rotation and zoom
+    // and the most observed point (the translation); with one, that point's coordinate most
+    // along the fixed line of sight (the shift along it, the one freedom left). Exactly the
+    // gauge is removed, so the reduced camera system is regular and Cholesky can solve it.
+    bool distinct = false;
+    for (size_t k = 1; k < fixedDirs.size() && !distinct; k++)
+        distinct = std::abs(fixedDirs[k].dot(fixedDirs[0])) <
+                   std::cos(kMinTriangulationDeg * CV_PI / 180);
+    ceres::SubsetManifold* holdAlong = nullptr;
+    std::unique_ptr<ceres::SubsetManifold> holdOwner;
+    if (!distinct && firstVar >= 0)
     {
-        problem.SetParameterBlockConstant(q[firstVar].coeffs().data());
-        problem.SetParameterBlockConstant(&s[firstVar]);
+        int anchor = -1, anchorObs = 0;
+        for (int p = 0; p < P; p++)
+        {
+            if (!pointUsed[p])
+                continue;
+            int n = 0;
+            for (int k = idx_.pointStart[p]; k < idx_.pointStart[p + 1]; k++)
+                n += views_[idx_.byFrame[idx_.byPoint[k]].frame].solved ? 1 : 0;
+            if (n > anchorObs)
+            {
+                anchorObs = n;
+                anchor = p;
+            }
+        }
+        if (fixedDirs.empty())
+        {
+            problem.SetParameterBlockConstant(q(firstVar));
+            problem.SetParameterBlockConstant(s(firstVar));
+            if (anchor >= 0)
+                problem.SetParameterBlockConstant(X.ptr<double>(anchor));
+        }
+        else if (anchor >= 0)
+        {
+            const Vec3d& d = fixedDirs[0];
+            int axis = 0;
+            for (int k = 1; k < 3; k++)
+                if (std::abs(d[k]) > std::abs(d[axis]))
+                    axis = k;
+            holdOwner.reset(new ceres::SubsetManifold(3, {axis}));
+            holdAlong = holdOwner.get();
+            problem.SetManifold(X.ptr<double>(anchor), holdAlong);
+        }
     }
     ceres::Solver::Options o;
     o.minimizer_type = ceres::TRUST_REGION;
     o.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-    // The implicit Schur complement with conjugate gradients, as the refiner's adjustments: the
-    // translation gauge (a shift of every point absorbed by the image translations) leaves the
-    // reduced camera system singular, which a Cholesky factorization reports as a failure.
-    o.linear_solver_type = ceres::ITERATIVE_SCHUR;
-    o.preconditioner_type = ceres::JACOBI;
-    o.use_explicit_schur_complement = false;
+    // Frames overlap their neighbours only: the reduced camera system is sparse.
+    o.linear_solver_type = ceres::SPARSE_SCHUR;
     o.linear_solver_ordering.reset(ordering);
     o.max_num_iterations = iterations;
     o.function_tolerance = 1e-6;
@@ -508,9 +556,9 @@ void IncrementalBuilder::bundleAdjust(const std::vector<uchar>& variable, int it
     for (int f = 0; f < F; f++)
         if (inProblem[f] && variable[f])
         {
-            views_[f].R = fromQuaternion(q[f]);
-            views_[f].t = t[f];
-            views_[f].s = s[f];
+            views_[f].R = fromQuaternion(Eigen::Quaterniond(q(f)[3], q(f)[0], q(f)[1], q(f)[2]));
+            views_[f].t = Vec2d(t(f)[0], t(f)[1]);
+            views_[f].s = *s(f);
         }
     for (int p = 0; p < P; p++)
         if (pointUsed[p])
