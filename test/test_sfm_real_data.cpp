@@ -174,6 +174,8 @@ Reconstruction centredPrincipalPoint(const Reconstruction& gt)
 // trades with intrinsics that augocc's cameras do not have (dino_Ps: principal point 31 degrees
 // off the image centre, aspect ratio 1.4). The scaled-orthographic bundle adjustment started
 // from dino_Ps' own rotations drifts to the same 23-25 deg offset (lower cost under the model),
+// the offset is all elevation of the cameras above the turntable plane (26.9 deg here, 2.7 in
+// dino_Ps, 33.3 once its principal point is centred),
 // the relative rotation angles match (10.0 deg a step), and the same
 // full-turn short-track geometry with a centred principal point is recovered to 0.3 deg
 // (Augocc_SfmSynth.full_turn_short_tracks_perspective). Checked here: the turn angle of every
