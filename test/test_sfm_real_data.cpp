@@ -238,5 +238,135 @@ TEST(Augocc_SfmRealData, oxford_dinosaur)
     EXPECT_LE(cmp.maxRotationDeg - cmp.meanRotationDeg, kMaxOffsetSpreadDeg);
 }
 
+// Linear (DLT) points of the dinosaur tracks through dino_Ps (the sign of P does not matter);
+// NaN rows where fewer than two views see the track.
+Mat triangulateDlt(const Tracks& tracks, const Reconstruction& gt)
+{
+    Mat X(tracks.points(), 3, CV_64F, Scalar::all(std::numeric_limits<double>::quiet_NaN()));
+    for (int p = 0; p < tracks.points(); p++)
+    {
+        Mat A;
+        for (const Camera& cam : gt.cameras)
+        {
+            if (!tracks.observed(cam.frame, p))
+                continue;
+            const Matx34d P = cam.projectionMatrix();
+            const Point2f q = tracks.at(cam.frame, p);
+            for (int a = 0; a < 2; a++)
+            {
+                const double m = a == 0 ? q.x : q.y;
+                Mat row(1, 4, CV_64F);
+                for (int c = 0; c < 4; c++)
+                    row.at<double>(c) = m * P(2, c) - P(a, c);
+                A.push_back(Mat(row / cv::norm(row)));
+            }
+        }
+        if (A.rows < 4)
+            continue;
+        Mat w, u, vt;
+        SVD::compute(A, w, u, vt, SVD::FULL_UV);
+        const double h = vt.at<double>(3, 3);
+        if (std::abs(h) < 1e-12)
+            continue;
+        for (int k = 0; k < 3; k++)
+            X.at<double>(p, k) = vt.at<double>(3, k) / h;
+    }
+    return X;
+}
+
+// The dinosaur's geometry (its points, dino_Ps' camera centres, the tracks' visibility: 36 views
+// over a full turn, 3.3 views per track) imaged by cameras with square pixels and a centred
+// principal point, each aimed along dino_Ps' ray through the image centre (f = sqrt(fx fy)),
+// 0.2 px noise (the real tracks' median residual). Where the intrinsics are those augocc
+// assumes, the turntable is recovered: this separates the method from dino_Ps' calibration
+// (measured: noise-free, 2e-5 deg; the same tracks rendered through dino_Ps' own intrinsics
+// give the 24 deg elevation offset of the real tracks at a 0.003 px median). The affine path
+// followed by the bundle adjustments passes this clean case too (0.08 deg); it is the real
+// tracks on which it failed (RMS 1.73 px, 77 deg).
+TEST(Augocc_SfmRealData, oxford_dinosaur_geometry_square_pixels)
+{
+    AUGOCC_REQUIRE_SHARED_DATA(path, "oxford_dinosaur/tracks.yml");
+    AUGOCC_REQUIRE_SHARED_DATA(psPath, "oxford_dinosaur/dino_Ps.txt");
+    const Tracks tracks = readTracks(path);
+    Reconstruction gt;
+    ASSERT_TRUE(readDinoCameras(psPath, gt));
+    Mat X = triangulateDlt(tracks, gt);
+    Vec3d c;
+    cv::augocc::detail::rmsRadius(X, &c);
+    // Points in front of every camera (P's sign), and a right-handed world (mirror z if the
+    // left 3x3 of P then has a negative determinant), then P = K [R | t] by RQ.
+    std::vector<Matx34d> P(36);
+    for (int f = 0; f < 36; f++)
+    {
+        P[f] = gt.cameras[f].projectionMatrix();
+        if ((P[f] * Vec4d(c[0], c[1], c[2], 1))[2] < 0)
+            P[f] = P[f] * -1.0;
+    }
+    const bool mirror = determinant(P[0].get_minor<3, 3>(0, 0)) < 0;
+    const Matx33d Z(1, 0, 0, 0, 1, 0, 0, 0, -1);
+    if (mirror)
+        for (int p = 0; p < X.rows; p++)
+            X.at<double>(p, 2) = -X.at<double>(p, 2);
+    const Point2d centre(359.5, 287.5);
+    Reconstruction sq;
+    sq.model = PERSPECTIVE;
+    sq.imageSize = gt.imageSize;
+    for (int f = 0; f < 36; f++)
+    {
+        const Matx33d M = mirror ? P[f].get_minor<3, 3>(0, 0) * Z : P[f].get_minor<3, 3>(0, 0);
+        Matx33d K, R;
+        RQDecomp3x3(M, K, R);
+        for (int d = 0; d < 3; d++)
+            if (K(d, d) < 0)
+            {
+                for (int r = 0; r < 3; r++)
+                    K(r, d) = -K(r, d);
+                for (int k = 0; k < 3; k++)
+                    R(d, k) = -R(d, k);
+            }
+        ASSERT_GT(determinant(R), 0);
+        const Vec3d t = K.inv() * Vec3d(P[f](0, 3), P[f](1, 3), P[f](2, 3));
+        K *= 1.0 / K(2, 2);
+        Vec3d ray = K.inv() * Vec3d(centre.x, centre.y, 1.0);
+        ray /= cv::norm(ray);
+        const Vec3d axis = ray.cross(Vec3d(0, 0, 1));
+        const double sn = cv::norm(axis);
+        Matx33d Ra = Matx33d::eye();
+        if (sn > 0)
+            Rodrigues(axis * (std::atan2(sn, ray[2]) / sn), Ra);
+        const double fl = std::sqrt(K(0, 0) * K(1, 1));
+        sq.cameras.push_back(Camera::perspective(Ra * R, Ra * t,
+                             Matx33d(fl, 0, centre.x, 0, fl, centre.y, 0, 0, 1), f));
+    }
+    Tracks rendered = tracks;
+    rendered.tracks = Mat(tracks.tracks.size(), CV_32FC2,
+                          Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    RNG rng(36);
+    const double kNoisePx = 0.2;
+    for (int f = 0; f < 36; f++)
+        for (int p = 0; p < tracks.points(); p++)
+        {
+            const double* x = X.ptr<double>(p);
+            if (!tracks.observed(f, p) || !std::isfinite(x[0]))
+                continue;
+            const Vec3d Xw(x[0], x[1], x[2]);
+            ASSERT_GT(sq.cameras[f].toCamera(Xw)[2], 0);
+            const Point2d q = sq.cameras[f].project(Xw);
+            rendered.tracks.at<Point2f>(f, p) = Point2f((float)(q.x + rng.gaussian(kNoisePx)),
+                                                        (float)(q.y + rng.gaussian(kNoisePx)));
+        }
+    SfmReport rep;
+    const Reconstruction rec = recoverCameras(rendered, SfmOptions(), &rep);
+    ASSERT_EQ(36, (int)rec.cameras.size());
+    const CameraComparison cmp = compareCameras(rec, sq, rec.model == SCALED_ORTHOGRAPHIC);
+    std::cout << "oxford_dinosaur geometry, square-pixel cameras, " << kNoisePx << " px noise: "
+              << "model " << rep.chosenModel << ", rotation error mean " << cmp.meanRotationDeg
+              << " deg, max " << cmp.maxRotationDeg << " deg" << std::endl;
+    const double kMaxMeanDeg = 0.5;   // measured 0.084 (seed 36); the noise-free fit: 2e-5
+    const double kMaxDeg = 1.0;       // measured 0.28
+    EXPECT_LE(cmp.meanRotationDeg, kMaxMeanDeg);
+    EXPECT_LE(cmp.maxRotationDeg, kMaxDeg);
+}
+
 } // namespace
 } // namespace opencv_test
