@@ -57,10 +57,14 @@ const int kLocalWindow = 6;
 // A global adjustment and a rejection round each time the reconstructed frames grew by this
 // factor (the geometric schedule of COLMAP's global BA).
 const double kGlobalGrowth = 1.25;
-// Iterations of the Gauss-Newton resection and of the intermediate adjustments.
+// Iterations of the Gauss-Newton resection and of the adjustments. The global adjustments
+// before the last crawl along flat valleys (Oxford dinosaur: 35-39 iterations at 50, 0.1% lower
+// cost); capped at 15 they leave the final cameras the same to 0.001 deg at half the run time
+// (the last adjustment and recoverCameras' bundle adjustments finish the descent).
 const int kResectIterations = 20;
 const int kLocalBaIterations = 10;
-const int kGlobalBaIterations = 50;
+const int kGlobalBaIterations = 15;
+const int kFinalBaIterations = 50;
 // Parameters of one camera in the adjustments: quaternion (4), translation (2), zoom (1).
 const int kCamBlock = 7;
 
@@ -618,7 +622,7 @@ void IncrementalBuilder::run()
         if (views_[f].solved)
             order_.push_back(f);
     std::vector<uchar> all(F, 1);
-    bundleAdjust(all, kGlobalBaIterations);
+    bundleAdjust(all, kFinalBaIterations);   // the start: a few frames, converged in full
     rejectTracks();
     int lastGlobal = solvedFrames();
     for (;;)
@@ -650,7 +654,7 @@ void IncrementalBuilder::run()
     bundleAdjust(all, kGlobalBaIterations);
     rejectTracks();
     triangulateNew(true);
-    bundleAdjust(all, kGlobalBaIterations);
+    bundleAdjust(all, kFinalBaIterations);
     rejectTracks();
     CV_LOG_INFO(NULL, cv::format("augocc sfm: incremental reconstruction: %d of %d frames, "
                 "inlier threshold %.2f px", solvedFrames(), F, thr_));
