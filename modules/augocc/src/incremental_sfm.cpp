@@ -4,17 +4,19 @@
 // Incremental scaled-orthographic reconstruction: the missing-data path of FactorizationSfM for
 // long sequences whose tracks are short (a turntable seen over a full turn, a long walk).
 //
-// Why: the affine missing-data fit (alternation, Buchanan & Fitzgibbon 2005) has 8 free
-// parameters per frame; when frames are linked only through chains of short overlaps, the
-// affine cameras may drift along the chain ("bending": every overlap is fitted, the whole is
-// not a rigid motion), and a metric upgrade of the whole cannot undo it. Measured on the Oxford
-// dinosaur (36 views over 360 degrees, 3.3 views per track): 77 degrees mean rotation error at a
-// 0.3 px median reprojection error. Metric cameras (a rotation, a zoom and an image
-// translation: 6 parameters) forbid the bending: each new frame is resected as a
-// scaled-orthographic camera from the points already triangulated, so the rigidity of the
-// motion is imposed at every step, as in incremental SfM (Snavely, Seitz & Szeliski 2006
-// "Photo tourism"; Schoenberger & Frahm 2016 "Structure-from-motion revisited", COLMAP), here
-// specialised to scaled orthography:
+// Why: the affine missing-data fit (alternation, Buchanan & Fitzgibbon 2005) has 8 free parameters
+// per frame; when frames are linked only through chains of short overlaps, the affine cameras may
+// drift along the chain ("bending": every overlap is fitted, the whole is not a rigid motion), and
+// a metric upgrade of the whole cannot undo it. Measured: a synthetic full turn (72 frames, 3-11
+// views per track) came out of the factorization with 4.0 deg mean, 10.4 deg max rotation error
+// (0.13 / 0.29 deg on this path); on the Oxford dinosaur (36 views over 360 degrees, 3.3 views per
+// track) recoverCameras ended 77 deg mean, 178 deg max from VGG's cameras at an RMS of 1.73 px
+// (this path: a consistent turn, RMS 0.36 px). Metric cameras (a rotation, a zoom and an image
+// translation: 6 parameters) forbid the bending: each new frame is resected as a scaled-
+// orthographic camera from the points already triangulated, so the rigidity of the motion is
+// imposed at every step, as in incremental SfM (Snavely, Seitz & Szeliski 2006 "Photo tourism";
+// Schoenberger & Frahm 2016 "Structure-from-motion revisited", COLMAP), here specialised to scaled
+// orthography:
 //   1. start: the metric upgrade (Tomasi-Kanade) of the largest complete block, done by the
 //      caller;
 //   2. triangulate every track seen by two reconstructed frames whose lines of sight differ by
