@@ -903,9 +903,43 @@ bool FactorizationSfMImpl::reconstructIncremental(SfmData& d, Reconstruction& ou
     m.solvedFrame.assign(F, 0);
     m.solvedPoint.assign(P, 0);
     Vec3d sv;
-    factorBlock(d, frames, tr, m, sv);
+    // Gross outliers in the block (a sliding T-junction adds a rank of its own and can hide the
+    // rotation's third singular value): rejection rounds on the block, the rule of the
+    // factorization below (RMS residual to the rank-3 fit against max(floor, sigmas x median)).
+    for (int round = 0; round < params_.maxRejectionRounds; round++)
+    {
+        factorBlock(d, frames, tr, m, sv);
+        std::vector<double> res(tr.size());
+        for (size_t c = 0; c < tr.size(); c++)
+        {
+            int n = 0;
+            const double* x = m.X.ptr<double>(tr[c]);
+            const double ssr = trackSsr(d, tr[c], m, Vec3d(x[0], x[1], x[2]), n);
+            res[c] = std::sqrt(ssr / std::max(1, n));
+        }
+        std::vector<double> sorted = res;
+        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+        const double thr = std::max(params_.outlierThreshold,
+                                    params_.outlierSigmas * sorted[sorted.size() / 2]);
+        std::vector<int> kept;
+        for (size_t c = 0; c < tr.size(); c++)
+            if (res[c] <= thr)
+                kept.push_back(tr[c]);
+        if (kept.size() == tr.size())
+            break;
+        if ((int)kept.size() < kMinBlockTracks)
+            return false;
+        for (int p : tr)
+            m.solvedPoint[p] = 0;
+        tr = kept;
+    }
     if (sv[1] < kMinRankGap * sv[2] || sv[1] <= kMinRankRatio * sv[0])
+    {
+        CV_LOG_INFO(NULL, cv::format("augocc sfm: incremental start: the complete block frames "
+                    "%d..%d has no rank-3 motion (s3 / s4 = %.2f)", frames.front(), frames.back(),
+                    sv[1] / std::max(sv[2], 1e-300)));
         return false;
+    }
     Matx33d Q;
     try
     {
