@@ -17,8 +17,8 @@
 // imposed at every step, as in incremental SfM (Snavely, Seitz & Szeliski 2006 "Photo tourism";
 // Schoenberger & Frahm 2016 "Structure-from-motion revisited", COLMAP), here specialised to scaled
 // orthography:
-//   1. start: the metric upgrade (Tomasi-Kanade) of the largest complete block, done by the
-//      caller;
+//   1. start: the metric upgrade (Tomasi-Kanade) of the largest complete block after
+//      rejection rounds on it, done by the caller (factorization_sfm.cpp);
 //   2. triangulate every track seen by two reconstructed frames whose lines of sight differ by
 //      at least kMinTriangulationDeg (COLMAP's min_tri_angle: 1.5 degrees) and whose residual is
 //      below the inlier threshold;
