@@ -126,7 +126,7 @@ private:
     bool triangulate(int p, Vec3d& X) const;
     int bestFrame() const;
     bool resect(int f);
-    double resectFrom(int f, const std::vector<Vec3d>& Xs, const std::vector<Vec2d>& obs,
+    double resectFrom(const std::vector<Vec3d>& Xs, const std::vector<Vec2d>& obs,
                       OrthoView& v) const;
     void bundleAdjust(const std::vector<uchar>& variable, int iterations);
     int rejectTracks();
@@ -243,10 +243,9 @@ int IncrementalBuilder::bestFrame() const
 
 // Robust Gauss-Newton of one scaled-orthographic pose (rotation updated on the left by a
 // rotation vector, zoom, translation) from the start in `v`; returns the Huber cost.
-double IncrementalBuilder::resectFrom(int f, const std::vector<Vec3d>& Xs,
+double IncrementalBuilder::resectFrom(const std::vector<Vec3d>& Xs,
                                       const std::vector<Vec2d>& obs, OrthoView& v) const
 {
-    CV_UNUSED(f);
     const int n = (int)Xs.size();
     auto cost = [&](const OrthoView& c) {
         double e = 0;
@@ -389,7 +388,7 @@ bool IncrementalBuilder::resect(int f)
     OrthoView bestView;
     for (OrthoView v : starts)
     {
-        const double c = resectFrom(f, Xs, obs, v);
+        const double c = resectFrom(Xs, obs, v);
         if (c < best)
         {
             best = c;
@@ -508,8 +507,7 @@ void IncrementalBuilder::bundleAdjust(const std::vector<uchar>& variable, int it
     for (size_t k = 1; k < fixedDirs.size() && !distinct; k++)
         distinct = std::abs(fixedDirs[k].dot(fixedDirs[0])) <
                    std::cos(kMinTriangulationDeg * CV_PI / 180);
-    ceres::SubsetManifold* holdAlong = nullptr;
-    std::unique_ptr<ceres::SubsetManifold> holdOwner;
+    std::unique_ptr<ceres::SubsetManifold> holdAlong;   // outlives the problem's solve
     if (!distinct && firstVar >= 0)
     {
         int anchor = -1, anchorObs = 0;
@@ -540,9 +538,8 @@ void IncrementalBuilder::bundleAdjust(const std::vector<uchar>& variable, int it
             for (int k = 1; k < 3; k++)
                 if (std::abs(d[k]) > std::abs(d[axis]))
                     axis = k;
-            holdOwner.reset(new ceres::SubsetManifold(3, {axis}));
-            holdAlong = holdOwner.get();
-            problem.SetManifold(X.ptr<double>(anchor), holdAlong);
+            holdAlong.reset(new ceres::SubsetManifold(3, {axis}));
+            problem.SetManifold(X.ptr<double>(anchor), holdAlong.get());
         }
     }
     ceres::Solver::Options o;
