@@ -48,6 +48,29 @@ struct CV_EXPORTS AffineModel
     std::vector<uchar> solvedFrame, solvedPoint;
 };
 
+//! A scaled-orthographic view of the incremental reconstruction: u = s (R X + t).xy + c, with c
+//! the image centre (Camera::orthographic with t = (t.x, t.y, any depth)).
+struct CV_EXPORTS OrthoView
+{
+    Matx33d R = Matx33d::eye();
+    Vec2d t = Vec2d(0, 0);
+    double s = 0;
+    bool solved = false;
+};
+
+/** @brief Incremental scaled-orthographic reconstruction (resection of metric cameras,
+triangulation, local and global bundle adjustment; incremental_sfm.cpp) grown from a start.
+@param idx the observations.
+@param usable tracks that may be used (one flag per track).
+@param pp the principal point (image centre).
+@param outlierThreshold floor of the track rejection threshold, pixels RMS.
+@param outlierSigmas the threshold is max(floor, this x the median track RMS residual).
+@param views in: the start (solved views, at least three), out: every view reconstructed.
+@param X in/out: P x 3 CV_64F points, NaN rows for tracks without a point (rejected ones too). */
+CV_EXPORTS void growIncremental(const ObservationIndex& idx, const std::vector<uchar>& usable,
+                                const Point2d& pp, double outlierThreshold,
+                                double outlierSigmas, std::vector<OrthoView>& views, Mat& X);
+
 /** @brief Metric upgrade of an affine motion (Tomasi-Kanade): least squares for the symmetric
 L = Q Q^T under i^T L i = 1, j^T L j = 1, i^T L j = 0 for every solved frame, nearest
 positive-definite repair, Q = V sqrt(D).

@@ -28,6 +28,14 @@ Beyond the paper:
   initialised on the largest complete block of frames x tracks, grown by affine triangulation and
   resection, and then refined by alternation (the ALS baseline of Buchanan & Fitzgibbon
   @cite Buchanan2005) over every observation;
+- long sequences with short tracks (mean track length below a quarter of the frames, at least
+  12 frames): the affine alternation may bend along the chain of short overlaps, so the
+  reconstruction is built incrementally with metric cameras instead (@cite Snavely2006,
+  @cite Schoenberger2016, specialised to scaled orthography): metric upgrade of the largest
+  complete block, then resection of one scaled-orthographic camera at a time from the
+  triangulated points, triangulation of the tracks seen twice, local and periodic global
+  bundle adjustment with track rejection. Its cameras keep their own zoom (mean 1); if it
+  cannot start (no complete block of three distinct views), the factorization path runs;
 - gross outliers: tracks whose RMS residual to the affine fit exceeds a robust threshold are
   rejected, the fit redone without them, and so on until the set is stable; a rejected track's
   row in `points` is NaN;
