@@ -15,7 +15,8 @@ CloneBuilder::Params::Params()
     : voxelPixels(1.0), maxVoxels((int64)1 << 27), maxEnlargeIterations(20),
       orientation(ORIENT_AUTO), userRotation(0, 0, 0), raysPerPixel(2), patchRule(PATCH_NEAREST),
       occlusionAware(true), trimFraction(0.02), minPoints(4), photoThreshold(15),
-      photoMinAgreement(0.95), photoMinViews(4), photoRounds(1), photoPatchStep(0)
+      photoMinAgreement(0.95), photoMinViews(4), photoRounds(1), photoPatchStep(0),
+      photoMaxViews(24)
 {
 }
 
@@ -587,6 +588,9 @@ public:
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoRounds must be >= 1");
         if (p.photoPatchStep < 0 || p.photoPatchStep > 8)
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoPatchStep must be in [0, 8]");
+        if (p.photoMaxViews < 0 || (p.photoMaxViews > 0 && p.photoMaxViews < p.photoMinViews))
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoMaxViews must be 0 (every "
+                     "frame) or at least photoMinViews");
         params_ = p;
     }
 
@@ -929,6 +933,7 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
     pp.minViews = params_.photoMinViews;
     pp.rounds = params_.photoRounds;
     pp.patchStep = params_.photoPatchStep;
+    pp.maxViews = params_.photoMaxViews;
     const std::map<String, int64> carved = photoCarve(*set, rec, frames, pp);
     int64 total = 0;
     for (const auto& c : carved)

@@ -64,6 +64,7 @@ struct PhotoCarveParams
     int minViews = 4;
     int rounds = 1;
     int patchStep = 0;
+    int maxViews = 0;  // 0: every camera
 };
 
 /** @brief Space carving by photo-consistency on every frame with a camera (CloneBuilder::refine):

@@ -424,7 +424,13 @@ std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstruction& rec,
                                    const std::vector<Mat>& frames, const PhotoCarveParams& p)
 {
     const std::vector<String> names = set.objectNames();
-    const int nc = (int)rec.cameras.size();
+    // The cameras compared: at most maxViews, evenly spaced over the reconstruction's (fixed
+    // indices: the same for any thread count).
+    const int total = (int)rec.cameras.size();
+    const int nc = p.maxViews > 0 ? std::min(total, p.maxViews) : total;
+    std::vector<const Camera*> use(nc);
+    for (int c = 0; c < nc; c++)
+        use[c] = &rec.cameras[nc > 1 ? (int)((int64)c * (total - 1) / (nc - 1)) : 0];
     const int no = (int)names.size();
     const Size size = rec.imageSize;
     std::map<String, int64> carved;
@@ -447,9 +453,9 @@ std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstruction& rec,
             ov[o].image.resize(nc);
             for (int c = 0; c < nc; c++)
             {
-                ov[o].proj[c] = g.projector(rec.cameras[c], size);
+                ov[o].proj[c] = g.projector(*use[c], size);
                 ov[o].roi[c] = g.imageBounds(ov[o].proj[c]);
-                ov[o].image[c] = &frames[rec.cameras[c].frame];
+                ov[o].image[c] = &frames[use[c]->frame];
             }
         }
         // Objects hide each other: per camera, the nearest depth of the other clones as they
@@ -459,7 +465,7 @@ std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstruction& rec,
                 std::vector<Mat> depth(no);
                 for (int c = r.start; c < r.end; c++)
                 {
-                    const Camera& cam = rec.cameras[c];
+                    const Camera& cam = *use[c];
                     for (int o = 0; o < no; o++)
                         set.render(names[o], cam.frame, cam, size, noArray(), depth[o]);
                     for (int a = 0; a < no; a++)

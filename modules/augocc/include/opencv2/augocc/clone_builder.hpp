@@ -148,6 +148,12 @@ public:
         phantoms in front of uniform bands, but erodes true edges where the patch straddles an
         occluding contour; measured in doc/clones.md). */
         int photoPatchStep;
+        /** refine(): at most this many frames are compared, evenly spaced over the cameras of
+        the reconstruction (default 24; 0 = every frame). Neighbouring frames of a video add
+        little evidence: on the synthesized 60-frame scene 24 views gave the same IoUs as all 60
+        (L-block depth error 37.1 voxels instead of 35.4; 42.4 unrefined) and `augocc run` on 100
+        frames spent 1.4 s instead of 4.4 s in the clone stage. */
+        int photoMaxViews;
     };
 
     static Ptr<CloneBuilder> create(const Params& params);
