@@ -1074,6 +1074,11 @@ TEST(Augocc_CloneBuilder_Photo, bad_arg)
     p = CloneBuilder::Params();
     p.photoMinViews = 1;
     EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
+    p = CloneBuilder::Params();
+    p.photoMaxViews = p.photoMinViews - 1;  // fewer views than a decision needs
+    EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
+    p.photoMaxViews = -1;
+    EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
     // Uniform frames: every voxel is consistent, nothing is carved and the clone is unchanged.
     const int before = clones->voxelCount("tower");
     EXPECT_EQ(b->refine(*clones, s.rec, good), 0);
