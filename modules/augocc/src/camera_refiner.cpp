@@ -58,37 +58,6 @@ OrthoCameraRefiner::Params::Params()
 
 namespace {
 
-// Relative accuracy of the bundle adjustments' inexact Newton steps (Ceres' Solver::Options::eta)
-// and the conjugate-gradient steps allowed for one (Ceres' default: 500). Well-conditioned
-// problems (100 x 1000 full tracks, CMU hotel) need 2-25 CG steps for 1e-3; on the Oxford
-// dinosaur (91% missing) 1e-3 took 100-400 a step and tripled the time, while capping them at
-// 50 kept the time of the 10% default and reached a lower cost.
-const double kBundleForcing = 1e-3;
-const int kBundleMaxCgSteps = 50;
-
-Eigen::Quaterniond toQuat(const Matx33d& R)
-{
-    Eigen::Matrix3d m;
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++)
-            m(r, c) = R(r, c);
-    Eigen::Quaterniond q(m);
-    q.normalize();
-    return q;
-}
-
-Matx33d fromQuat(const double* xyzw)
-{
-    Eigen::Quaterniond q(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
-    q.normalize();
-    const Eigen::Matrix3d m = q.toRotationMatrix();
-    Matx33d R;
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++)
-            R(r, c) = m(r, c);
-    return R;
-}
-
 class OrthoCameraRefinerImpl CV_FINAL : public OrthoCameraRefiner
 {
 public:
@@ -135,8 +104,8 @@ private:
             // Newton steps solved to 0.1% (Ceres' default forcing term is 10%): started from
             // the factorization, two such steps reach the optimum, where 10% steps crawled for
             // five (100 x 1000: 5 -> 3 Jacobian evaluations for a few more cheap CG steps).
-            o.eta = kBundleForcing;
-            o.max_linear_solver_iterations = kBundleMaxCgSteps;
+            o.eta = detail::kBundleForcing;
+            o.max_linear_solver_iterations = detail::kBundleMaxCgSteps;
         }
     }
 
@@ -303,7 +272,7 @@ bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction&
     double sGlobal = 0;
     for (int i = 0; i < n; i++)
     {
-        q[i] = toQuat(rec.cameras[i].R);
+        q[i] = detail::toQuaternion(rec.cameras[i].R);
         t[i] = Vec2d(rec.cameras[i].t[0], rec.cameras[i].t[1]);
         s[i] = rec.cameras[i].s;
         sGlobal += s[i] / n;
@@ -366,7 +335,7 @@ bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction&
     for (int i = 0; i < n; i++)
     {
         Camera& cam = rec.cameras[i];
-        cam.R = fromQuat(q[i].coeffs().data());
+        cam.R = detail::fromQuaternion(q[i].coeffs().data());
         const Vec3d Rc = cam.R * c;
         cam.t = Vec3d(t[i][0] + Rc[0], t[i][1] + Rc[1], cam.t[2]);
         cam.s = params_.perFrameScale ? s[i] : sGlobal;
@@ -410,7 +379,7 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     for (int i = 0; i < n; i++)
     {
         const Camera& cam = rec.cameras[i];
-        q[i] = toQuat(cam.R);
+        q[i] = detail::toQuaternion(cam.R);
         const Vec3d Rc = cam.R * c;
         if (rec.model == PERSPECTIVE)
         {
@@ -493,7 +462,7 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     {
         Camera& cam = rec.cameras[i];
         const Point2d pp = cam.principalPoint();
-        Matx33d R = fromQuat(q[i].coeffs().data());
+        Matx33d R = detail::fromQuaternion(q[i].coeffs().data());
         Vec3d ti = t[i];
         if (mirror)
         {

@@ -321,6 +321,17 @@ FactorizationSfM::Params::Params()
 
 namespace {
 
+// The inlier flags of reconstruct(): 1 where a track's point was kept (finite), 0 where rejected.
+void writeInliers(const Mat& points, OutputArray inliersOut)
+{
+    if (!inliersOut.needed())
+        return;
+    Mat inl(points.rows, 1, CV_8U);
+    for (int p = 0; p < points.rows; p++)
+        inl.at<uchar>(p) = std::isfinite(points.at<double>(p, 0)) ? 1 : 0;
+    inl.copyTo(inliersOut);
+}
+
 // A frame is resected from at least this many points (an affine camera has 8 unknowns, 2
 // equations per point; 6 leaves a margin against near-coplanar sets).
 const int kMinResectPoints = 6;
@@ -1036,13 +1047,7 @@ bool FactorizationSfMImpl::reconstructIncremental(SfmData& d, Reconstruction& ou
         rec.cameras.push_back(Camera::orthographic(R, t, views[f].s / sMean, pp, f));
     }
     out = rec;
-    if (inliersOut.needed())
-    {
-        Mat inl(P, 1, CV_8U);
-        for (int p = 0; p < P; p++)
-            inl.at<uchar>(p) = std::isfinite(rec.points.at<double>(p, 0)) ? 1 : 0;
-        inl.copyTo(inliersOut);
-    }
+    writeInliers(rec.points, inliersOut);
     return true;
 }
 
@@ -1278,13 +1283,7 @@ bool FactorizationSfMImpl::reconstruct(const Tracks& tracks, Reconstruction& out
         rec.cameras.push_back(cam);
     }
     out = rec;
-    if (inliersOut.needed())
-    {
-        Mat inl(P, 1, CV_8U);
-        for (int p = 0; p < P; p++)
-            inl.at<uchar>(p) = std::isfinite(rec.points.at<double>(p, 0)) ? 1 : 0;
-        inl.copyTo(inliersOut);
-    }
+    writeInliers(rec.points, inliersOut);
     return true;
 }
 

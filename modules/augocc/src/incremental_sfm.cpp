@@ -72,32 +72,8 @@ const int kGlobalBaIterations = 10;
 const int kFinalBaIterations = 50;
 // Observations per point up to which the adjustments use sparse Cholesky (see bundleAdjust).
 const double kNarrowBandObs = 6.0;
-// Ceres forcing term and conjugate-gradient cap of the iterative adjustments: the values of the
-// refiner's bundle adjustments (camera_refiner.cpp).
-const double kBundleForcing = 1e-3;
-const int kBundleMaxCgSteps = 50;// Parameters of one camera in the adjustments: quaternion (4), translation (2), zoom (1).
+// Parameters of one camera in the adjustments: quaternion (4), translation (2), zoom (1).
 const int kCamBlock = 7;
-
-Eigen::Quaterniond toQuaternion(const Matx33d& R)
-{
-    Eigen::Matrix3d m;
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++)
-            m(r, c) = R(r, c);
-    Eigen::Quaterniond q(m);
-    q.normalize();
-    return q;
-}
-
-Matx33d fromQuaternion(const Eigen::Quaterniond& q)
-{
-    const Eigen::Matrix3d m = q.normalized().toRotationMatrix();
-    Matx33d R;
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++)
-            R(r, c) = m(r, c);
-    return R;
-}
 
 inline Vec2d projectView(const OrthoView& v, const Point2d& pp, const double* X)
 {
@@ -585,7 +561,7 @@ void IncrementalBuilder::bundleAdjust(const std::vector<uchar>& variable, int it
     for (int f = 0; f < F; f++)
         if (inProblem[f] && variable[f])
         {
-            views_[f].R = fromQuaternion(Eigen::Quaterniond(q(f)[3], q(f)[0], q(f)[1], q(f)[2]));
+            views_[f].R = fromQuaternion(q(f));
             views_[f].t = Vec2d(t(f)[0], t(f)[1]);
             views_[f].s = *s(f);
         }
