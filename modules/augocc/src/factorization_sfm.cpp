@@ -321,6 +321,18 @@ FactorizationSfM::Params::Params()
 
 namespace {
 
+// Moves the finite points (rows of `points`) so that their centroid is the origin; `centre` is
+// that centroid before the move. Returns their RMS radius (the scale of the cameras' depth).
+double centrePoints(Mat& points, Vec3d& centre)
+{
+    const double radius = detail::rmsRadius(points, &centre);
+    for (int p = 0; p < points.rows; p++)
+        if (std::isfinite(points.at<double>(p, 0)))
+            for (int k = 0; k < 3; k++)
+                points.at<double>(p, k) -= centre[k];
+    return radius;
+}
+
 // The inlier flags of reconstruct(): 1 where a track's point was kept (finite), 0 where rejected.
 void writeInliers(const Mat& points, OutputArray inliersOut)
 {
@@ -1030,12 +1042,7 @@ bool FactorizationSfMImpl::reconstructIncremental(SfmData& d, Reconstruction& ou
             rec.points.at<double>(p, k) = Xw[k];
     }
     Vec3d c;
-    const double radius = detail::rmsRadius(rec.points, &c);
-    for (int p = 0; p < P; p++)
-        if (std::isfinite(rec.points.at<double>(p, 0)))
-            for (int k = 0; k < 3; k++)
-                rec.points.at<double>(p, k) -= c[k];
-    const double depth = params_.depthRatio * std::max(radius, 1.0);
+    const double depth = params_.depthRatio * std::max(centrePoints(rec.points, c), 1.0);
     for (int f = 0; f < F; f++)
     {
         if (!views[f].solved)
@@ -1254,12 +1261,7 @@ bool FactorizationSfMImpl::reconstruct(const Tracks& tracks, Reconstruction& out
         rec.points.at<double>(p, 2) = Xw[2];
     }
     Vec3d c;
-    const double radius = detail::rmsRadius(rec.points, &c);
-    for (int p = 0; p < P; p++)
-        if (std::isfinite(rec.points.at<double>(p, 0)))
-            for (int k = 0; k < 3; k++)
-                rec.points.at<double>(p, k) -= c[k];
-    const double depth = params_.depthRatio * std::max(radius, 1.0);
+    const double depth = params_.depthRatio * std::max(centrePoints(rec.points, c), 1.0);
     for (int f = 0; f < F; f++)
     {
         if (!solvedFrame[f])
