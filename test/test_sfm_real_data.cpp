@@ -82,6 +82,20 @@ TEST(Augocc_SfmRealData, cmu_hotel_landmarks)
     EXPECT_EQ(101, (int)rec.cameras.size());
 }
 
+// M = K R by RQ decomposition with K's diagonal positive (the sign moved into R's rows).
+void decomposeKR(const Matx33d& M, Matx33d& K, Matx33d& R)
+{
+    RQDecomp3x3(M, K, R);
+    for (int d = 0; d < 3; d++)
+        if (K(d, d) < 0)
+        {
+            for (int r = 0; r < 3; r++)
+                K(r, d) = -K(r, d);
+            for (int c = 0; c < 3; c++)
+                R(d, c) = -R(d, c);
+        }
+}
+
 // Reads dino_Ps.txt: 36 blocks of 3 lines; P maps X to (row, col, w). Rows 0 and 1 are
 // swapped to get the contract's (x = col, y = row), then P is decomposed to K [R | t].
 bool readDinoCameras(const std::string& path, Reconstruction& gt)
@@ -118,15 +132,7 @@ bool readDinoCameras(const std::string& path, Reconstruction& gt)
             M = M * -1.0;
         }
         Matx33d K, R;
-        RQDecomp3x3(M, K, R);
-        for (int d = 0; d < 3; d++)
-            if (K(d, d) < 0)
-            {
-                for (int r = 0; r < 3; r++)
-                    K(r, d) = -K(r, d);
-                for (int c = 0; c < 3; c++)
-                    R(d, c) = -R(d, c);
-            }
+        decomposeKR(M, K, R);
         const double k22 = K(2, 2);
         const Vec3d t = K.inv() * Vec3d(P(0, 3), P(1, 3), P(2, 3));
         K *= 1.0 / k22;
@@ -314,15 +320,7 @@ TEST(Augocc_SfmRealData, oxford_dinosaur_geometry_square_pixels)
     {
         const Matx33d M = mirror ? P[f].get_minor<3, 3>(0, 0) * Z : P[f].get_minor<3, 3>(0, 0);
         Matx33d K, R;
-        RQDecomp3x3(M, K, R);
-        for (int d = 0; d < 3; d++)
-            if (K(d, d) < 0)
-            {
-                for (int r = 0; r < 3; r++)
-                    K(r, d) = -K(r, d);
-                for (int k = 0; k < 3; k++)
-                    R(d, k) = -R(d, k);
-            }
+        decomposeKR(M, K, R);
         ASSERT_GT(determinant(R), 0);
         const Vec3d t = K.inv() * Vec3d(P[f](0, 3), P[f](1, 3), P[f](2, 3));
         K *= 1.0 / K(2, 2);
