@@ -121,11 +121,11 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
     SyntheticScene scene;
     synth->synthesize(scene);
     Ptr<CloneBuilder> builder = CloneBuilder::create();
-    Ptr<CloneSet> silhouetteClones = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    Ptr<CloneSet> silhouetteClones = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
     const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth,
                                                 silhouetteClones.get());
     // Clones from the silhouettes alone, then carved further by photo-consistency.
-    Ptr<CloneSet> photoClones = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    Ptr<CloneSet> photoClones = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
     builder->refine(*photoClones, scene.groundTruth, scene.frames);
     for (int photo : {0, 1})
     for (int k : {1, 3})
@@ -166,8 +166,14 @@ TEST(Augocc_Pipeline, DISABLED_accuracy_gt_cameras_built_clones_experiment)
                 Mat diff, row;
                 absdiff(result, truth, diff);
                 hconcat(std::vector<Mat>{truth, result, diff * 4}, row);
-                imwrite("/tmp/comp_p" + std::to_string(photo) + "_k" + std::to_string(k) + ".png",
-                        row(Rect(100, 100, 1720, 260)));
+                Mat dg; cvtColor(diff, dg, COLOR_BGR2GRAY);
+                Rect bb = boundingRect(dg > 8);
+                bb.x -= 30; bb.y -= 30; bb.width += 60; bb.height += 60;
+                bb &= Rect(0, 0, truth.cols, truth.rows);
+                Mat crop;
+                hconcat(std::vector<Mat>{truth(bb), result(bb), diff(bb) * 4}, crop);
+                resize(crop, crop, Size(), 4, 4, INTER_NEAREST);
+                imwrite("/tmp/comp_p" + std::to_string(photo) + "_k" + std::to_string(k) + ".png", crop);
                 imwrite("/tmp/truth4.png", truth4);
                 imwrite("/tmp/truth1.png", truth);
             }
@@ -197,8 +203,8 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
     SyntheticScene scene;
     synth->synthesize(scene);
     Ptr<CloneBuilder> builder = CloneBuilder::create();
-    Ptr<CloneSet> built = builder->build(scene.groundTruth, scene.keyFrameMasks);
-    Ptr<CloneSet> refined = builder->build(scene.groundTruth, scene.keyFrameMasks);
+    Ptr<CloneSet> built = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
+    Ptr<CloneSet> refined = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
     builder->refine(*refined, scene.groundTruth, scene.frames);
     MeshClones exact(scene.objectNames, scene.objectMeshes);
     const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth, built.get());

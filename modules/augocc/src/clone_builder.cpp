@@ -16,7 +16,7 @@ CloneBuilder::Params::Params()
       orientation(ORIENT_AUTO), userRotation(0, 0, 0), raysPerPixel(2), patchRule(PATCH_NEAREST),
       occlusionAware(true), trimFraction(0.02), minPoints(4), photoThreshold(15),
       photoMinAgreement(0.95), photoMinViews(4), photoRounds(1), photoPatchStep(0),
-      photoMaxViews(24)
+      photoMaxViews(24), freeSpaceMinViews(2), freeSpaceEdgeMargin(0.5)
 {
 }
 
@@ -144,7 +144,8 @@ int silhouetteVotes(const Reconstruction& rec, const ObjectMasks& all, const Str
 // they are consistent with other objects too (a point behind one object and seen inside another's
 // silhouette), held by this object's silhouettes in at least as many key frames as by any other's.
 std::vector<Vec3d> clusterPoints(const Reconstruction& rec, const ObjectMasks& all,
-                                 const String& object, const Tracks* tracks)
+                                 const String& object, const Tracks* tracks,
+                                 std::vector<int>* indices = nullptr)
 {
     std::vector<Vec3d> out;
     if (rec.points.empty())
@@ -168,7 +169,11 @@ std::vector<Vec3d> clusterPoints(const Reconstruction& rec, const ObjectMasks& a
                 break;
             }
         if (best)
+        {
             out.push_back(X);
+            if (indices)
+                indices->push_back(p);
+        }
     }
     return out;
 }
@@ -591,6 +596,10 @@ public:
         if (p.photoMaxViews < 0 || (p.photoMaxViews > 0 && p.photoMaxViews < p.photoMinViews))
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::photoMaxViews must be 0 (every "
                      "frame) or at least photoMinViews");
+        if (p.freeSpaceMinViews < 0)
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::freeSpaceMinViews must be >= 0");
+        if (!(p.freeSpaceEdgeMargin >= 0) || !std::isfinite(p.freeSpaceEdgeMargin))
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::freeSpaceEdgeMargin must be >= 0");
         params_ = p;
     }
 
@@ -826,9 +835,10 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
     Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
     set->patchRule = params_.patchRule;
     // Steps 1-3 per object.
+    std::map<String, std::vector<int> > members;
     for (const auto& o : bins)
     {
-        std::vector<Vec3d> pts = clusterPoints(rec, bins, o.first, tracks);
+        std::vector<Vec3d> pts = clusterPoints(rec, bins, o.first, tracks, &members[o.first]);
         const Matx33d R = orientationFor(rec, pts);
         Box box;
         Vec3d centre;
@@ -863,6 +873,21 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
             frames.push_back(m.first);
         carveAndPatch(set->objects, o.second, rec, frames, params_.occlusionAware,
                       params_.raysPerPixel);
+    }
+    // Beyond the paper: the free space the tracks show.
+    if (tracks && params_.freeSpaceMinViews > 0)
+    {
+        FreeSpaceParams fp;
+        fp.minViews = params_.freeSpaceMinViews;
+        fp.edgeMargin = params_.freeSpaceEdgeMargin;
+        for (const auto& c : freeSpaceCarve(*set, rec, *tracks, members, fp))
+        {
+            CV_LOG_DEBUG(NULL, cv::format("augocc: object '%s': %lld voxels carved by free space",
+                         c.first.c_str(), (long long)c.second));
+            if (c.second > 0)
+                recomputePatches(set->objects, set->get(c.first), rec, params_.occlusionAware,
+                                 params_.raysPerPixel);
+        }
     }
     return set;
 }

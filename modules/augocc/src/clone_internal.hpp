@@ -75,6 +75,27 @@ CV_EXPORTS std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstru
                                               const std::vector<Mat>& frames,
                                               const PhotoCarveParams& params);
 
+//! Free-space carving parameters (CloneBuilder::Params::freeSpace*).
+struct FreeSpaceParams
+{
+    int minViews = 2;          // a voxel goes when at least this many frames show it free
+    double marginVoxels = 3;   // free space ends at least this many voxel edges before the points
+    double edgeMargin = 0.5;   // ... and this fraction of the triangle's longest edge
+    double maxEdgePx = 40;     // longer triangles are not used
+    double maxReprojPx = 2;    // observations farther than this from their point are not used
+    int maxViews = 30;         // frames used, evenly spaced (0: all)
+};
+
+/** @brief Free-space carving from the tracks: in every frame, the triangles (Delaunay, in the
+image) of the object's points seen there are empty in front of their nearest vertex by a margin;
+voxels shown free by at least params.minViews frames go, peeled from the surface, never one that
+a key-frame silhouette pixel needs. `members` lists each object's points (Step 1). Updates the
+grids and surfaces (not the patches). Returns the voxels carved per object. */
+CV_EXPORTS std::map<String, int64> freeSpaceCarve(CloneSetImpl& set, const Reconstruction& rec,
+                                                  const Tracks& tracks,
+                                                  const std::map<String, std::vector<int> >& members,
+                                                  const FreeSpaceParams& params);
+
 } // namespace detail
 } // namespace augocc
 } // namespace cv

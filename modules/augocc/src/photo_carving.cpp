@@ -7,6 +7,7 @@
 
 #include "precomp.hpp"
 #include "clone_internal.hpp"
+#include "key_frame_coverage.hpp"
 
 #include <memory>
 
@@ -96,116 +97,6 @@ bool consistent(const std::vector<Point>& px, const std::vector<const Mat*>& img
     return agree >= need;
 }
 
-// Key-frame protection: per key frame, how many surface voxels' footprints cover each pixel. The
-// union of the surface's footprints is the clone's matte (the renderer draws only the surface),
-// so a carve that would bring a silhouette pixel to zero is refused: the user's silhouettes stay
-// covered by the model itself, not only by patch voxels.
-class Coverage
-{
-public:
-    Coverage(VoxelGrid& g, const ObjectClone& obj, const Reconstruction& rec) : g_(g)
-    {
-        for (const auto& m : obj.masks)
-        {
-            sil_.push_back(&m.second);
-            proj_.push_back(g_.projector(rec.camera(m.first), m.second.size()));
-        }
-        count_.resize(sil_.size());
-        const SurfaceVoxels s = g_.surface();
-        parallel_for_(Range(0, (int)sil_.size()), [&](const Range& r) {
-            for (int q = r.start; q < r.end; q++)
-            {
-                count_[q].create(sil_[q]->size(), CV_16U);
-                count_[q].setTo(Scalar(0));
-                for (uint32_t v : s.ijk)
-                {
-                    int i, j, k;
-                    unpackVoxel(v, i, j, k);
-                    add(q, i, j, k, 1);
-                }
-            }
-        });
-    }
-
-    bool isSurface(int i, int j, int k) const
-    {
-        const VoxelGrid& g = g_;
-        return i == 0 || j == 0 || k == 0 || i + 1 == g.dims[0] || j + 1 == g.dims[1] ||
-               k + 1 == g.dims[2] || !g.data[g.index(i - 1, j, k)] ||
-               !g.data[g.index(i + 1, j, k)] || !g.data[g.index(i, j - 1, k)] ||
-               !g.data[g.index(i, j + 1, k)] || !g.data[g.index(i, j, k - 1)] ||
-               !g.data[g.index(i, j, k + 1)];
-    }
-
-    /** Carves voxel (i, j, k) (inside, on the surface) unless a key-frame silhouette pixel would
-    lose its last cover; the neighbours it exposes join the surface. True when carved. */
-    bool tryCarve(int i, int j, int k)
-    {
-        static const int nb[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0},
-                                     {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
-        exposed_.clear();
-        for (int n = 0; n < 6; n++)
-        {
-            const int a = i + nb[n][0], b = j + nb[n][1], c = k + nb[n][2];
-            if (g_.inside(a, b, c) && g_.data[g_.index(a, b, c)] && !isSurface(a, b, c))
-                exposed_.push_back(Vec3i(a, b, c));
-        }
-        for (size_t q = 0; q < count_.size(); q++)
-            for (const Vec3i& e : exposed_)
-                add(q, e[0], e[1], e[2], 1);
-        bool ok = true;
-        for (size_t q = 0; q < count_.size() && ok; q++)
-        {
-            int x0, x1, y0, y1;
-            double z;
-            if (!proj_[q].footprint(i, j, k, x0, x1, y0, y1, z))
-                continue;
-            const Mat& s = *sil_[q];
-            const Mat& c = count_[q];
-            for (int y = std::max(y0, 0); y <= std::min(y1, s.rows - 1) && ok; y++)
-                for (int x = std::max(x0, 0); x <= std::min(x1, s.cols - 1); x++)
-                    if (s.at<uchar>(y, x) && c.at<ushort>(y, x) <= 1)
-                    {
-                        ok = false;
-                        break;
-                    }
-        }
-        if (!ok)
-        {
-            for (size_t q = 0; q < count_.size(); q++)
-                for (const Vec3i& e : exposed_)
-                    add(q, e[0], e[1], e[2], -1);
-            return false;
-        }
-        for (size_t q = 0; q < count_.size(); q++)
-            add(q, i, j, k, -1);
-        g_.data[g_.index(i, j, k)] = 0;
-        return true;
-    }
-
-private:
-    void add(size_t q, int i, int j, int k, int d)
-    {
-        int x0, x1, y0, y1;
-        double z;
-        if (!proj_[q].footprint(i, j, k, x0, x1, y0, y1, z))
-            return;
-        Mat& c = count_[q];
-        for (int y = std::max(y0, 0); y <= std::min(y1, c.rows - 1); y++)
-        {
-            ushort* row = c.ptr<ushort>(y);
-            for (int x = std::max(x0, 0); x <= std::min(x1, c.cols - 1); x++)
-                row[x] = (ushort)std::min(65535, std::max(0, row[x] + d));
-        }
-    }
-
-    VoxelGrid& g_;
-    std::vector<const Mat*> sil_;
-    std::vector<VoxelProjector> proj_;
-    std::vector<Mat> count_;
-    std::vector<Vec3i> exposed_;
-};
-
 // Camera data of one object for one round: every frame with a camera.
 struct ObjectViews
 {
@@ -219,7 +110,7 @@ struct ObjectViews
 // planes in order of increasing distance along the sweep, cameras that look along it. A surface
 // voxel is seen in a camera when no kept voxel of an earlier plane (by the ordinal visibility
 // constraint, the only possible occluders) and no other clone covers its centre pixel nearer
-// than the tolerance. Inconsistent voxels go (Coverage permitting); carving exposes the voxels
+// than the tolerance. Inconsistent voxels go (KeyFrameCoverage permitting); carving exposes the voxels
 // behind them in the plane, which are checked in turn, then the plane's kept surface is drawn
 // into the cameras' cover maps. Returns the number of voxels carved.
 // Cameras that may take part in a sweep along +-axis `axis` of the grid.
@@ -248,7 +139,7 @@ std::vector<int> sweepCameras(const VoxelGrid& g, int axis, int sign, const Obje
 }
 
 int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
-            const ObjectViews& ov, Coverage& cov, const PhotoCarveParams& p)
+            const ObjectViews& ov, KeyFrameCoverage& cov, const PhotoCarveParams& p)
 {
     const int nv = (int)cams.size();
     std::vector<Mat> cover(nv);
@@ -434,11 +325,11 @@ std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstruction& rec,
     const int no = (int)names.size();
     const Size size = rec.imageSize;
     std::map<String, int64> carved;
-    std::vector<std::unique_ptr<Coverage> > cov;
+    std::vector<std::unique_ptr<KeyFrameCoverage> > cov;
     for (const String& n : names)
     {
         ObjectClone& obj = set.get(n);
-        cov.emplace_back(new Coverage(obj.grid, obj, rec));
+        cov.emplace_back(new KeyFrameCoverage(obj.grid, obj, rec));
         carved[n] = 0;
     }
     for (int round = 0; round < p.rounds; round++)

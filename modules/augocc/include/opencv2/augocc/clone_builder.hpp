@@ -154,6 +154,19 @@ public:
         (L-block depth error 37.1 voxels instead of 35.4; 42.4 unrefined) and `augocc run` on 100
         frames spent 1.4 s instead of 4.4 s in the clone stage. */
         int photoMaxViews;
+        /** build() with tracks, free-space carving beyond the paper: a point tracked in a frame
+        is seen there, so in that frame the triangles (Delaunay, in the image) between an
+        object's points are empty in front of their nearest corner, by a margin of 3 voxels or
+        freeSpaceEdgeMargin times the triangle's longest edge, whichever is larger. A voxel that
+        at least this many frames show free goes (peeled from the surface; never one a key-frame
+        silhouette pixel needs). Carves the visual hull's depth phantoms that silhouettes from a
+        narrow orbit leave in front of facades and in concavities (default 2; 0 = off; measured
+        in doc/clones.md). */
+        int freeSpaceMinViews;
+        /** Free-space margin per pixel of triangle edge, as a fraction of the edge (default 0.5):
+        a triangle spanning a convex corner passes in front of the corner by up to about half its
+        edge, which the margin keeps. Lower carves closer to flat facades. */
+        double freeSpaceEdgeMargin;
     };
 
     static Ptr<CloneBuilder> create(const Params& params);
@@ -169,7 +182,8 @@ public:
     @param keyFrameMasks per object, the user's silhouettes in its key frames (CV_8U, > 127 = in,
     the reconstruction's image size).
     @param tracks optional: the tracks `rec.points` came from; when given, a point is clustered by
-    the key frames in which its track is observed, else by every key frame where it projects.
+    the key frames in which its track is observed, else by every key frame where it projects, and
+    the clones are carved further by the free space the tracks show (Params::freeSpaceMinViews).
     @return the clone set.
     Throws StsBadArg / StsBadSize naming the object and frame for an empty or all-white mask, a mask
     of the wrong size or for a frame with no camera.

@@ -1,0 +1,211 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// Free-space carving of the clones from the tracks (beyond the paper). A point tracked in frame f
+// is seen there, so the line of sight between the camera and the point is empty: the visibility
+// constraint of surface reconstruction from structure from motion (Faugeras, Le Bras-Mehlman &
+// Boissonnat 1990; Labatut, Pons & Keriven 2007). Single lines of sight are too sparse to carve a
+// solid volume (a voxel's rays hit a feature in about one frame in 300 on the synthesized
+// scene), so, as those methods do with their triangulations, the free space is spread over the
+// Delaunay triangles of an object's points in the image: a triangle is taken as empty in front
+// of its nearest corner, less a margin that grows with its size (a triangle that spans a convex
+// corner passes in front of the corner). The visual hull from a narrow orbit is deep along the
+// lines of sight (a box seen over 50 degrees keeps a wedge in front of its facade) and fills
+// concavities (an L-shaped block's inner corner); these phantoms hide virtual objects that
+// stand in front of the real ones, and free space removes them where the object has texture.
+// Only each object's own points (Step 1) carve its grid, so a featureless object in front of a
+// textured one is not carved by the other's triangles.
+
+#include "precomp.hpp"
+#include "clone_internal.hpp"
+#include "key_frame_coverage.hpp"
+
+namespace cv {
+namespace augocc {
+namespace detail {
+
+namespace {
+
+// One frame's free-space map for one object: per pixel, the camera depth in front of which the
+// line of sight is empty (-inf where nothing is known). Observations farther than maxReprojPx
+// from their point's projection (a track that slid along an occluding contour) are left out.
+Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vector<int>& pts,
+                 const Camera& cam, double h, const FreeSpaceParams& params)
+{
+    const int f = cam.frame;
+    const Size size = rec.imageSize;
+    const Rect img(0, 0, size.width, size.height);
+    std::vector<Point2f> px;
+    std::vector<double> z;
+    const double r2 = params.maxReprojPx * params.maxReprojPx;
+    for (int p : pts)
+    {
+        if (f >= tracks.frames() || !tracks.observed(f, p))
+            continue;
+        const double* X = rec.points.ptr<double>(p);
+        const Vec3d Xw(X[0], X[1], X[2]);
+        const Point2f o = tracks.at(f, p);
+        const Point2d q = cam.project(Xw);
+        const double dx = q.x - o.x, dy = q.y - o.y;
+        const double d = cam.depth(Xw);
+        if (dx * dx + dy * dy > r2 || !img.contains(Point(cvFloor(o.x), cvFloor(o.y))) ||
+            (cam.model == PERSPECTIVE && !(d > 0)))
+            continue;
+        px.push_back(o);
+        z.push_back(d);
+    }
+    if (px.size() < 3)
+        return Mat();
+    Subdiv2D sub(Rect(-1, -1, size.width + 2, size.height + 2));
+    // Vertex position -> depth (the nearest of coincident points).
+    std::map<std::pair<float, float>, double> depthOf;
+    for (size_t q = 0; q < px.size(); q++)
+    {
+        const std::pair<float, float> key(px[q].x, px[q].y);
+        auto it = depthOf.find(key);
+        if (it == depthOf.end())
+        {
+            sub.insert(px[q]);
+            depthOf[key] = z[q];
+        }
+        else
+            it->second = std::min(it->second, z[q]);
+    }
+    std::vector<Vec6f> tris;
+    sub.getTriangleList(tris);
+    struct Tri
+    {
+        Point v[3];
+        float value;
+    };
+    std::vector<Tri> keep;
+    for (const Vec6f& t : tris)
+    {
+        Tri tri;
+        double zmin = std::numeric_limits<double>::infinity(), edge = 0;
+        bool ok = true;
+        for (int c = 0; c < 3 && ok; c++)
+        {
+            const Point2f a(t[2 * c], t[2 * c + 1]), b(t[(2 * c + 2) % 6], t[(2 * c + 3) % 6]);
+            edge = std::max(edge, (double)cv::norm(a - b));
+            auto it = depthOf.find(std::pair<float, float>(a.x, a.y));
+            ok = it != depthOf.end();
+            if (ok)
+                zmin = std::min(zmin, it->second);
+            tri.v[c] = Point(cvRound(a.x * 16), cvRound(a.y * 16));
+        }
+        if (!ok || edge > params.maxEdgePx)
+            continue;
+        const double ppu = cam.pixelsPerUnit(zmin);
+        const double margin = std::max(params.marginVoxels * h, params.edgeMargin * edge / ppu);
+        tri.value = (float)(zmin - margin);
+        keep.push_back(tri);
+    }
+    if (keep.empty())
+        return Mat();
+    // Nearer values last: a pixel shared by two triangles keeps the nearer (conservative).
+    std::stable_sort(keep.begin(), keep.end(),
+                     [](const Tri& a, const Tri& b) { return a.value > b.value; });
+    Mat free(size, CV_32F, Scalar(-std::numeric_limits<float>::infinity()));
+    for (const Tri& t : keep)
+        fillConvexPoly(free, t.v, 3, Scalar(t.value), LINE_8, 4);
+    return free;
+}
+
+} // namespace
+
+std::map<String, int64> freeSpaceCarve(CloneSetImpl& set, const Reconstruction& rec,
+                                       const Tracks& tracks,
+                                       const std::map<String, std::vector<int> >& members,
+                                       const FreeSpaceParams& params)
+{
+    std::map<String, int64> carved;
+    if (rec.points.empty() || params.minViews <= 0)
+        return carved;
+    std::vector<const Camera*> cams;
+    const int nc = (int)rec.cameras.size();
+    const int nv = params.maxViews > 0 ? std::min(params.maxViews, nc) : nc;
+    for (int q = 0; q < nv; q++)
+        cams.push_back(&rec.cameras[nv > 1 ? (int)((int64)q * (nc - 1) / (nv - 1)) : 0]);
+    for (auto& o : set.objects)
+    {
+        ObjectClone& obj = o.second;
+        VoxelGrid& g = obj.grid;
+        carved[o.first] = 0;
+        auto mit = members.find(o.first);
+        if (g.empty() || mit == members.end() || mit->second.size() < 3)
+            continue;
+        std::vector<Mat> free(cams.size());
+        std::vector<VoxelProjector> proj(cams.size());
+        parallel_for_(Range(0, (int)cams.size()), [&](const Range& r) {
+            for (int q = r.start; q < r.end; q++)
+            {
+                free[q] = freeDepthMap(rec, tracks, mit->second, *cams[q], g.h, params);
+                proj[q] = g.projector(*cams[q], rec.imageSize);
+            }
+        });
+        // Votes per voxel: frames whose free space holds its centre.
+        const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+        std::vector<uchar> cand(g.data.size(), 0);
+        parallel_for_(Range(0, nz), [&](const Range& r) {
+            for (int k = r.start; k < r.end; k++)
+                for (int j = 0; j < ny; j++)
+                    for (int i = 0; i < nx; i++)
+                    {
+                        const size_t idx = g.index(i, j, k);
+                        if (!g.data[idx])
+                            continue;
+                        int votes = 0;
+                        for (size_t q = 0; q < proj.size() && votes < params.minViews; q++)
+                        {
+                            if (free[q].empty())
+                                continue;
+                            Point p;
+                            if (!proj[q].centrePixel(i, j, k, p) || p.x < 0 || p.y < 0 ||
+                                p.x >= free[q].cols || p.y >= free[q].rows)
+                                continue;
+                            const double zv = proj[q].Z.dot(Vec3d(i, j, k)) + proj[q].z0;
+                            votes += zv < free[q].at<float>(p);
+                        }
+                        cand[idx] = votes >= params.minViews;
+                    }
+        });
+        std::vector<Vec3i> list;
+        for (int k = 0; k < nz; k++)
+            for (int j = 0; j < ny; j++)
+                for (int i = 0; i < nx; i++)
+                    if (cand[g.index(i, j, k)])
+                        list.push_back(Vec3i(i, j, k));
+        if (list.empty())
+            continue;
+        // Peel: a candidate goes once it is on the surface (carving exposes the ones behind),
+        // unless a key-frame silhouette pixel would lose its last cover.
+        KeyFrameCoverage cov(g, obj, rec);
+        int64 n = 0;
+        for (bool changed = true; changed;)
+        {
+            changed = false;
+            size_t w = 0;
+            for (size_t q = 0; q < list.size(); q++)
+            {
+                const Vec3i& v = list[q];
+                if (cov.isSurface(v[0], v[1], v[2]) && cov.tryCarve(v[0], v[1], v[2]))
+                {
+                    n++;
+                    changed = true;
+                    continue;
+                }
+                list[w++] = v;
+            }
+            list.resize(w);
+        }
+        if (n > 0)
+            obj.surface = g.surface();
+        carved[o.first] = n;
+    }
+    return carved;
+}
+
+} // namespace detail
+} // namespace augocc
+} // namespace cv
