@@ -7,6 +7,7 @@
 #include <GL/gl.h>
 
 #include <filesystem>
+#include <unistd.h>
 #include <opencv2/videoio.hpp>
 
 namespace fs = std::filesystem;
@@ -109,6 +110,91 @@ struct Scores
     double within = 0, boundary = 0, band = 0;
     int frames = 0;
 };
+
+// Issue 5 with GT cameras: clones built from the key-frame masks and the tracks (free space),
+// refined by photo-consistency, the default compositor (soft edges, k = 3), the demo's dome and
+// tree; every third of 30 frames against the synthesizer's ground truth (1x render).
+// Measured 2026-12-01: 99.95% of pixels within 8 grey levels, occlusion boundary 0.21 px over the
+// 8 of 10 frames that have one (2.84 px before free-space carving, averaged over all frames: the
+// dome stands in the L-block's inner corner, which the visual hull fills).
+const double kGtMinWithin = 0.995;     // issue 5
+const double kGtMaxBoundaryPx = 1.0;   // issue 5
+
+TEST(Augocc_Pipeline, accuracy_gt_cameras_built_clones)
+{
+    SceneSynthesizer::Params sp;
+    sp.frames = 30;
+    sp.numKeyFrames = 6;
+    Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
+    SyntheticScene scene;
+    synth->synthesize(scene);
+    Ptr<CloneBuilder> builder = CloneBuilder::create();
+    Ptr<CloneSet> clones = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
+    builder->refine(*clones, scene.groundTruth, scene.frames);
+    const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth,
+                                                clones.get());
+    Ptr<Compositor> comp = Compositor::create();
+    comp->setVirtualObjects(meshes);
+    Compositor::Params hp;
+    hp.supersample = 1;
+    Ptr<Compositor> ref = Compositor::create(hp);
+    ref->setVirtualObjects(meshes);
+    Scores acc;
+    int withBoundary = 0;
+    for (int f = 0; f < sp.frames; f += 3)
+    {
+        const Camera& cam = scene.groundTruth.camera(f);
+        Mat result, layer, truth, refImg, refLayer, silImg, silLayer;
+        comp->composite(scene.frames[f], f, cam, *clones, result, layer);
+        ref->composite(scene.frames[f], cam, realDepth(scene, f), refImg, refLayer);
+        ref->composite(scene.frames[f], cam, noArray(), silImg, silLayer);
+        synth->renderWithVirtual(f, meshes, truth, 1);
+        std::vector<Mat> ch, rch, sch;
+        split(layer, ch);
+        split(refLayer, rch);
+        split(silLayer, sch);
+        const CompositeScore s = scoreComposite(result, truth, ch[3], rch[3] > 0, sch[3] > 0);
+        acc.within += s.fractionWithin;
+        acc.frames++;
+        if (s.boundaryPixels > 0)  // frames where the dome is hidden in part
+        {
+            acc.boundary += s.boundaryDistance;
+            withBoundary++;
+        }
+    }
+    std::cout << "GT cameras, built clones: " << 100 * acc.within / acc.frames
+              << "% within 8 grey levels, occlusion boundary " << acc.boundary / withBoundary
+              << " px over the " << withBoundary << " of " << acc.frames
+              << " frames that have one" << std::endl;
+    ASSERT_GE(2 * withBoundary, acc.frames);
+    EXPECT_GE(acc.within / acc.frames, kGtMinWithin);
+    EXPECT_LE(acc.boundary / withBoundary, kGtMaxBoundaryPx);
+}
+
+// Issue 5 from the video alone: `augocc demo` (track -> sfm -> clone -> matte -> composite on the
+// synthesized 60-frame video) scored against the ground truth. Measured 2026-12-01: 99.91%,
+// boundary 0.99 px over the frames that have one, rotation error 0.061 deg (before free-space
+// carving: 1.62 px averaged over all frames).
+const double kDemoMinWithin = 0.99;      // issue 5
+const double kDemoMaxBoundaryPx = 1.5;   // issue 5
+const double kDemoMaxRotationDeg = 0.3;  // issue 3 (track + sfm on a synthesized video)
+
+TEST(Augocc_Pipeline, accuracy_demo)
+{
+    DemoOptions o;
+    o.outDir = (fs::temp_directory_path() / cv::format("augocc_demo_test_%d", (int)getpid()))
+                   .string();
+    const DemoResult r = runDemo(o);
+    std::cout << "demo: " << 100 * r.fractionWithin << "% within 8 grey levels, occlusion boundary "
+              << r.boundaryDistance << " px, rotation error " << r.rotationErrorDeg << " deg"
+              << std::endl;
+    EXPECT_TRUE(fs::exists(r.compositePath));
+    EXPECT_TRUE(fs::exists(r.contactSheetPath));
+    EXPECT_GE(r.fractionWithin, kDemoMinWithin);
+    EXPECT_LE(r.boundaryDistance, kDemoMaxBoundaryPx);
+    EXPECT_LE(r.rotationErrorDeg, kDemoMaxRotationDeg);
+    fs::remove_all(o.outDir);
+}
 
 // GT cameras and clones built from the GT key-frame masks: the composite against the
 // synthesizer's ground truth (true geometry inserted).

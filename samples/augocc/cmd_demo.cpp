@@ -39,9 +39,9 @@ void registerDemo(CLI::App& app, Globals& g)
         info(g, "contact sheet: " + r.contactSheetPath);
         info(g, "scene file:    " + r.scenePath);
         info(g, cv::format("accuracy against the synthetic ground truth: %.2f%% of pixels within "
-                           "8 grey levels, occlusion boundary %.2f px, camera rotation error "
-                           "%.3f deg", 100 * r.fractionWithin, r.boundaryDistance,
-                           r.rotationErrorDeg));
+                           "8 grey levels, occlusion boundary %.2f px (mean over the %d frames "
+                           "with one), camera rotation error %.3f deg", 100 * r.fractionWithin,
+                           r.boundaryDistance, r.boundaryFrames, r.rotationErrorDeg));
     });
 }
 

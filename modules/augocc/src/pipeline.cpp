@@ -716,7 +716,11 @@ DemoResult runDemo(const DemoOptions& o)
         const CompositeScore s = scoreComposite(result, truth, alphaOf(layer),
                                                 alphaOf(refLayer) > 0, alphaOf(silLayer) > 0);
         res.fractionWithin += s.fractionWithin;
-        res.boundaryDistance += s.boundaryDistance;
+        if (s.boundaryPixels > 0 || s.boundaryDistance > 0)
+        {
+            res.boundaryDistance += s.boundaryDistance;
+            res.boundaryFrames++;
+        }
         scored++;
         if (f % std::max(1, (n - 1) / (kSheetFrames - 1)) == 0 &&
             (int)before.size() < kSheetFrames)
@@ -727,7 +731,7 @@ DemoResult runDemo(const DemoOptions& o)
     }
     CV_Assert(scored > 0);
     res.fractionWithin /= scored;
-    res.boundaryDistance /= scored;
+    res.boundaryDistance /= std::max(1, res.boundaryFrames);
     res.rotationErrorDeg /= scored;
     std::vector<Mat> sheet;
     for (size_t i = 0; i < before.size(); i++)

@@ -155,7 +155,8 @@ struct CV_EXPORTS DemoResult
     String compositePath, contactSheetPath, scenePath;
     RunResult run;
     double fractionWithin = 0;   //!< mean over frames, composite vs ground truth (8 grey levels)
-    double boundaryDistance = 0; //!< mean over frames, occlusion boundary, px
+    double boundaryDistance = 0; //!< occlusion boundary, px: mean over the boundaryFrames
+    int boundaryFrames = 0;      //!< frames where the truth or the composite has one
     double rotationErrorDeg = 0; //!< mean camera rotation error after alignment
 };
 
