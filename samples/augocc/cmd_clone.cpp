@@ -17,6 +17,7 @@ struct CloneOptions
     double voxelPixels = 1.0;
     int raysPerPixel = 2;
     bool noOcclusion = false;
+    bool noFreeSpace = false;
 };
 
 cv::Vec3d parseOrientation(const std::string& text)
@@ -42,6 +43,8 @@ void runClone(const CloneOptions& o, const Globals& g)
     p.voxelPixels = o.voxelPixels;
     p.raysPerPixel = o.raysPerPixel;
     p.occlusionAware = !o.noOcclusion;
+    if (o.noFreeSpace)
+        p.freeSpaceMinViews = 0;
     if (o.patchRule == "bracketing")
         p.patchRule = CloneBuilder::PATCH_BRACKETING;
     else if (o.patchRule != "nearest")
@@ -114,7 +117,7 @@ void registerClone(CLI::App& app, Globals& g)
         ->required();
     sub->add_option("--out", o->out, "clones file to write (.yml.gz)")->required();
     sub->add_option("--tracks", o->tracks, "tracks.yml the points came from (clusters points by "
-                    "the frames where they are seen)");
+                    "the frames where they are seen, and carves the free space they show)");
     sub->add_option("--orientation", o->orientation, "box rotation rx,ry,rz in degrees "
                     "(Rodrigues); default: automatic");
     sub->add_option("--input", o->input, "the video (or image folder, printf pattern): carve the "
@@ -127,6 +130,8 @@ void registerClone(CLI::App& app, Globals& g)
                     "nearest (default) or bracketing");
     sub->add_flag("--no-occlusion", o->noOcclusion, "carve under nearer objects' silhouettes too "
                   "(the paper's rule)");
+    sub->add_flag("--no-free-space", o->noFreeSpace, "with --tracks, do not carve the free space "
+                  "the tracks show (silhouettes only, the paper's rule)");
     sub->callback([o, &g]() { runClone(*o, g); });
 }
 
