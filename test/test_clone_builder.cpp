@@ -727,8 +727,9 @@ SynthFigures measureSynth(const CloneSet& clones, const SyntheticScene& s, const
 const double kHiddenObjectFraction = 0.02;
 // Hidden objects, mean IoU with the WHOLE true silhouette (as if alone) in non-key frames: the issue
 // asks 0.97; measured since voxels no key frame shows are dropped: lblock 0.972 / 0.979, tower
-// 0.959 / 0.959 (orthographic / perspective; the tower's cap overhang is a visual-hull limit,
-// 0.914 / 0.846 before). A regression bound 0.01 under the worst, not the target.
+// 0.959 / 0.959 (orthographic / perspective; 0.914 / 0.846 before), with free-space carving
+// (2026-12-01) tower 0.964 / 0.967: what is left is behind the building in every key frame and
+// behind the tower itself in the other views. A regression bound under the worst, not the target.
 const double kHiddenWholeMeanIoU = 0.95;
 
 typedef testing::TestWithParam<int> Augocc_CloneBuilder_Synth;
