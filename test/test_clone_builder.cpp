@@ -996,6 +996,49 @@ TEST_P(Augocc_CloneBuilder_FreeSpace_P, accuracy_synth)
 INSTANTIATE_TEST_SUITE_P(/**/, Augocc_CloneBuilder_FreeSpace_P,
                          testing::Values((int)SCALED_ORTHOGRAPHIC, (int)PERSPECTIVE));
 
+// Wrong points (a structure-from-motion mistake that the reprojection filter does not catch in
+// every frame): 10% of the points pushed 30 voxels deeper along the first camera's line of sight.
+// A triangle is free only in front of its nearest corner and only where its observations agree
+// with their points, so the clones must lose nothing of their silhouettes. Measured 2026-12-01
+// (76 wrong points): recall building 0.99941 -> 0.99928, lblock 0.99906 -> 0.99922, tower
+// 0.99698 -> 0.99826 (the boxes change with the points; no silhouette is eaten).
+const double kWrongPointsFraction = 0.1;
+const double kWrongPointsDepthVoxels = 30;
+
+TEST(Augocc_CloneBuilder_FreeSpace, robust_to_wrong_points)
+{
+    SyntheticScene s;
+    SceneSynthesizer::create()->synthesize(s);
+    CloneBuilder::Params off;
+    off.freeSpaceMinViews = 0;
+    Ptr<CloneSet> hull = CloneBuilder::create(off)->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+    Reconstruction rec = s.groundTruth;
+    rec.points = rec.points.clone();
+    const Vec3d dir = rec.cameras.front().viewDirection();
+    const double h = hull->voxelSize("building");
+    RNG rng(7);
+    int moved = 0;
+    for (int p = 0; p < rec.points.rows; p++)
+        if (std::isfinite(rec.points.at<double>(p, 0)) && rng.uniform(0.0, 1.0) < kWrongPointsFraction)
+        {
+            for (int c = 0; c < 3; c++)
+                rec.points.at<double>(p, c) += kWrongPointsDepthVoxels * h * dir[c];
+            moved++;
+        }
+    ASSERT_GT(moved, 20);
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(rec, s.keyFrameMasks, &s.tracks);
+    for (const String& name : clones->objectNames())
+    {
+        const SynthFigures f0 = measureSynth(*hull, s, name), f = measureSynth(*clones, s, name);
+        std::cout << name << ": recall " << f0.recall << " -> " << f.recall << ", non-key IoU "
+                  << f0.nonKeyMean << " -> " << f.nonKeyMean << " with " << moved
+                  << " wrong points" << std::endl;
+        EXPECT_GE(f.keyMin, kKeyFrameMinIoU) << name;
+        EXPECT_GE(f.recall, f0.recall - kFreeSpaceMaxRecallLoss) << name;
+        EXPECT_GE(f.nonKeyMean, f0.nonKeyMean - kFreeSpaceMaxIoULoss) << name;
+    }
+}
+
 TEST(Augocc_CloneBuilder_FreeSpace, multithread_reproducibility)
 {
     SceneSynthesizer::Params sp;
