@@ -287,7 +287,10 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
     SyntheticScene scene;
     synth->synthesize(scene);
-    Ptr<CloneBuilder> builder = CloneBuilder::create();
+    CloneBuilder::Params bp;
+    if (getenv("AUGOCC_VOXEL_PIXELS"))  // voxel edge of the built clones, in pixels
+        bp.voxelPixels = atof(getenv("AUGOCC_VOXEL_PIXELS"));
+    Ptr<CloneBuilder> builder = CloneBuilder::create(bp);
     Ptr<CloneSet> built = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
     Ptr<CloneSet> refined = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
     builder->refine(*refined, scene.groundTruth, scene.frames);
