@@ -217,6 +217,29 @@ BENCHMARK(Augocc_CloneBuilder_refine_synth)
     ->Name("Augocc_CloneBuilder/refine_synth_3objects_60frames_640x480")
     ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
+// build() on the synthesized scene (3 objects, 6 key frames, 60 frames of tracks, GT cameras):
+// Steps 1-5 from silhouettes only (arg 0) and with free-space carving from the tracks (arg 1).
+void Augocc_CloneBuilder_build_synth(benchmark::State& state)
+{
+    const RefineProblem& p = refineProblem();
+    CloneBuilder::Params params;
+    if (state.range(0) == 0)
+        params.freeSpaceMinViews = 0;
+    Ptr<CloneBuilder> b = CloneBuilder::create(params);
+    int64 voxels = 0;
+    for (auto _ : state)
+    {
+        Ptr<CloneSet> c = b->build(p.scene.groundTruth, p.scene.keyFrameMasks, &p.scene.tracks);
+        voxels = 0;
+        for (const String& name : c->objectNames())
+            voxels += c->voxelCount(name);
+    }
+    state.counters["voxels"] = (double)voxels;
+}
+BENCHMARK(Augocc_CloneBuilder_build_synth)
+    ->Name("Augocc_CloneBuilder/build_synth_3objects_640x480/free_space")->Arg(0)->Arg(1)
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
 // refine() on the 256^3 clone seen by 60 frames around the orbit, every frame one grey: every
 // visible surface voxel is checked against all its views and found consistent (the cost of the
 // visibility and consistency checks of a 256^3 surface; nothing is carved).

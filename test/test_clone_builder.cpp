@@ -989,7 +989,9 @@ TEST_P(Augocc_CloneBuilder_FreeSpace_P, accuracy_synth)
         EXPECT_GE(f.nonKeyMean, f0.nonKeyMean - kFreeSpaceMaxIoULoss) << name;
         EXPECT_LE(d.meanAbs, kFreeSpaceMaxDepthRatio * d0.meanAbs) << name;
         if (name == "lblock")
+        {
             EXPECT_LE(d.meanAbs, kFreeSpaceLblockDepthRatio * d0.meanAbs);
+        }
     }
 }
 
