@@ -144,60 +144,68 @@ std::map<String, int64> freeSpaceCarve(CloneSetImpl& set, const Reconstruction& 
                 proj[q] = g.projector(*cams[q], rec.imageSize);
             }
         });
-        // Votes per voxel: frames whose free space holds its centre.
-        const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
-        std::vector<uchar> cand(g.data.size(), 0);
-        parallel_for_(Range(0, nz), [&](const Range& r) {
-            for (int k = r.start; k < r.end; k++)
-                for (int j = 0; j < ny; j++)
-                    for (int i = 0; i < nx; i++)
-                    {
-                        const size_t idx = g.index(i, j, k);
-                        if (!g.data[idx])
-                            continue;
-                        int votes = 0;
-                        for (size_t q = 0; q < proj.size() && votes < params.minViews; q++)
-                        {
-                            if (free[q].empty())
-                                continue;
-                            Point p;
-                            if (!proj[q].centrePixel(i, j, k, p) || p.x < 0 || p.y < 0 ||
-                                p.x >= free[q].cols || p.y >= free[q].rows)
-                                continue;
-                            const double zv = proj[q].Z.dot(Vec3d(i, j, k)) + proj[q].z0;
-                            votes += zv < free[q].at<float>(p);
-                        }
-                        cand[idx] = votes >= params.minViews;
-                    }
-        });
-        std::vector<Vec3i> list;
-        for (int k = 0; k < nz; k++)
-            for (int j = 0; j < ny; j++)
-                for (int i = 0; i < nx; i++)
-                    if (cand[g.index(i, j, k)])
-                        list.push_back(Vec3i(i, j, k));
-        if (list.empty())
-            continue;
-        // Peel: a candidate goes once it is on the surface (carving exposes the ones behind),
-        // unless a key-frame silhouette pixel would lose its last cover.
+        // A voxel is free when at least minViews frames' free space holds its centre. Only the
+        // voxels the peel reaches are asked (the surface, then what each carve exposes), in
+        // waves: the wave's answers in parallel, then its carves in order (deterministic).
+        auto isFree = [&](int i, int j, int k) {
+            int votes = 0;
+            for (size_t q = 0; q < proj.size(); q++)
+            {
+                if (free[q].empty())
+                    continue;
+                Point px;
+                if (!proj[q].centrePixel(i, j, k, px) || px.x < 0 || px.y < 0 ||
+                    px.x >= free[q].cols || px.y >= free[q].rows)
+                    continue;
+                const double zv = proj[q].Z.dot(Vec3d(i, j, k)) + proj[q].z0;
+                if (zv < free[q].at<float>(px) && ++votes >= params.minViews)
+                    return true;
+            }
+            return false;
+        };
+        std::vector<uchar> queued(g.data.size(), 0);
+        std::vector<Vec3i> wave;
+        for (uint32_t v : obj.surface.ijk)
+        {
+            int i, j, k;
+            unpackVoxel(v, i, j, k);
+            wave.push_back(Vec3i(i, j, k));
+            queued[g.index(i, j, k)] = 1;
+        }
+        static const int nb[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0},
+                                     {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
         KeyFrameCoverage cov(g, obj, rec);
         int64 n = 0;
-        for (bool changed = true; changed;)
+        std::vector<uchar> answer;
+        while (!wave.empty())
         {
-            changed = false;
-            size_t w = 0;
-            for (size_t q = 0; q < list.size(); q++)
+            answer.assign(wave.size(), 0);
+            parallel_for_(Range(0, (int)wave.size()), [&](const Range& r) {
+                for (int q = r.start; q < r.end; q++)
+                    answer[q] = isFree(wave[q][0], wave[q][1], wave[q][2]);
+            });
+            std::vector<Vec3i> next;
+            for (size_t q = 0; q < wave.size(); q++)
             {
-                const Vec3i& v = list[q];
-                if (cov.isSurface(v[0], v[1], v[2]) && cov.tryCarve(v[0], v[1], v[2]))
-                {
-                    n++;
-                    changed = true;
+                const Vec3i& v = wave[q];
+                if (!answer[q] || !g.data[g.index(v[0], v[1], v[2])] ||
+                    !cov.isSurface(v[0], v[1], v[2]) || !cov.tryCarve(v[0], v[1], v[2]))
                     continue;
+                n++;
+                for (int e = 0; e < 6; e++)
+                {
+                    const int a = v[0] + nb[e][0], b = v[1] + nb[e][1], c = v[2] + nb[e][2];
+                    if (!g.inside(a, b, c))
+                        continue;
+                    const size_t idx = g.index(a, b, c);
+                    if (g.data[idx] && !queued[idx])
+                    {
+                        queued[idx] = 1;
+                        next.push_back(Vec3i(a, b, c));
+                    }
                 }
-                list[w++] = v;
             }
-            list.resize(w);
+            wave.swap(next);
         }
         if (n > 0)
             obj.surface = g.surface();
