@@ -81,7 +81,8 @@ struct FreeSpaceParams
     int minViews = 2;          // a voxel goes when at least this many frames show it free
     double marginVoxels = 3;   // free space ends at least this many voxel edges before the points
     double edgeMargin = 0.5;   // ... and this fraction of the triangle's longest edge
-    double maxEdgePx = 40;     // longer triangles are not used
+    double maxEdgeRatio = 2;   // triangles longer than this times the frame's median edge
+                               // (span gaps) are not used
     double maxReprojPx = 2;    // observations farther than this from their point are not used
     int maxViews = 30;         // frames used, evenly spaced (0: all)
 };

@@ -79,6 +79,7 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
         float value;
     };
     std::vector<Tri> keep;
+    std::vector<double> edges, depths;
     for (const Vec6f& t : tris)
     {
         Tri tri;
@@ -94,13 +95,33 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
                 zmin = std::min(zmin, it->second);
             tri.v[c] = Point(cvRound(a.x * 16), cvRound(a.y * 16));
         }
-        if (!ok || edge > params.maxEdgePx)
+        if (!ok)
             continue;
-        const double ppu = cam.pixelsPerUnit(zmin);
-        const double margin = std::max(params.marginVoxels * h, params.edgeMargin * edge / ppu);
-        tri.value = (float)(zmin - margin);
         keep.push_back(tri);
+        edges.push_back(edge);
+        depths.push_back(zmin);
     }
+    if (keep.empty())
+        return Mat();
+    // Triangles much longer than is typical for this frame's points span gaps (between two parts
+    // of the object, across a notch): they are left out. Relative, so that the rule does not
+    // depend on the image size or on how many tracks the tracker keeps.
+    std::vector<double> sorted = edges;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double maxEdge = params.maxEdgeRatio * sorted[sorted.size() / 2];
+    size_t w = 0;
+    for (size_t q = 0; q < keep.size(); q++)
+    {
+        if (edges[q] > maxEdge)
+            continue;
+        const double ppu = cam.pixelsPerUnit(depths[q]);
+        const double margin =
+            std::max(params.marginVoxels * h, params.edgeMargin * edges[q] / ppu);
+        keep[w] = keep[q];
+        keep[w].value = (float)(depths[q] - margin);
+        w++;
+    }
+    keep.resize(w);
     if (keep.empty())
         return Mat();
     // Nearer values last: a pixel shared by two triangles keeps the nearer (conservative).
