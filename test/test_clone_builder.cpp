@@ -917,6 +917,13 @@ const double kFreeSpaceMaxRecallLoss = 0.001;
 const double kFreeSpaceMaxIoULoss = 0.001;
 const double kFreeSpaceMaxDepthRatio = 0.98;
 const double kFreeSpaceLblockDepthRatio = 0.5;
+// Oxford dinosaur, 27 held-out views (measured 2026-12-01): IoU 0.830 -> 0.834, recall 0.9837 ->
+// 0.9822 without -> with free space. Bounds: recall may lose 3x what was measured; IoU must not drop.
+// The absolute IoU (worst view 0.48) is the masks': in some key frames a segmentation strip along
+// the image border touches the dinosaur, and its cone becomes part of the clone; the dinosaur
+// itself matches its held-out silhouettes to about a pixel (looked at, views 10 and 35).
+const double kFreeSpaceRealRecallLoss = 0.005;
+const double kFreeSpaceRealIoULoss = 0.0;
 
 TEST(Augocc_CloneBuilder_Photo, accuracy_synth)
 {
@@ -1039,6 +1046,71 @@ TEST(Augocc_CloneBuilder_FreeSpace, robust_to_wrong_points)
         EXPECT_GE(f.recall, f0.recall - kFreeSpaceMaxRecallLoss) << name;
         EXPECT_GE(f.nonKeyMean, f0.nonKeyMean - kFreeSpaceMaxIoULoss) << name;
     }
+}
+
+// Real data: the Oxford dinosaur (36-view turntable, VGG's tracks, student-made silhouettes; see
+// its SOURCE.txt). Cameras from recoverCameras() on the tracks, every fourth view a key frame, the
+// other 27 held out: free-space carving from the real tracks must not eat into the real
+// silhouettes it has not seen.
+TEST(Augocc_CloneBuilder_FreeSpace, oxford_dinosaur_held_out)
+{
+    AUGOCC_REQUIRE_SHARED_DATA(path, "oxford_dinosaur/tracks.yml");
+    AUGOCC_REQUIRE_SHARED_DATA(dir, "oxford_dinosaur/silhouettes");
+    const Tracks tracks = readTracks(path);
+    const Reconstruction rec = recoverCameras(tracks, SfmOptions());
+    std::map<int, Mat> sil;
+    for (const Camera& cam : rec.cameras)
+    {
+        const Mat m = imread(cv::format("%s/sil.%03d.png", dir.c_str(), cam.frame), IMREAD_GRAYSCALE);
+        ASSERT_FALSE(m.empty()) << cam.frame;
+        ASSERT_EQ(m.size(), rec.imageSize);
+        // The masks have segmentation strips along the image borders (SOURCE.txt): keep the
+        // largest connected component, the dinosaur.
+        Mat labels, stats, centroids;
+        const int nl = connectedComponentsWithStats(m > 127, labels, stats, centroids, 8);
+        int best = 1;
+        for (int l = 2; l < nl; l++)
+            if (stats.at<int>(l, CC_STAT_AREA) > stats.at<int>(best, CC_STAT_AREA))
+                best = l;
+        ASSERT_GT(nl, 1);
+        sil[cam.frame] = labels == best;
+    }
+    ObjectMasks masks;
+    for (const auto& fm : sil)
+        if (fm.first % 4 == 0)
+            masks["dino"][fm.first] = fm.second;
+    CloneBuilder::Params off;
+    off.freeSpaceMinViews = 0;
+    Ptr<CloneSet> hull = CloneBuilder::create(off)->build(rec, masks, &tracks);
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(rec, masks, &tracks);
+    double iou[2] = {0, 0}, recall[2] = {0, 0}, worst = 1;
+    int n = 0;
+    for (const auto& fm : sil)
+    {
+        if (fm.first % 4 == 0)
+            continue;
+        const Camera& cam = rec.camera(fm.first);
+        for (int q = 0; q < 2; q++)
+        {
+            Mat m;
+            (q ? clones : hull)->render("dino", fm.first, cam, rec.imageSize, m);
+            iou[q] += maskIoU(m, fm.second);
+            if (q == 1)
+            {
+                worst = std::min(worst, maskIoU(m, fm.second));
+            }
+            recall[q] += (double)countNonZero(m & fm.second) / std::max(1, countNonZero(fm.second));
+        }
+        n++;
+    }
+    ASSERT_GT(n, 0);
+    std::cout << "oxford dinosaur, " << n << " held-out views: IoU " << iou[0] / n << " -> "
+              << iou[1] / n << ", recall " << recall[0] / n << " -> " << recall[1] / n
+              << " (silhouettes only -> with free space), worst view " << worst << "; voxels "
+              << hull->voxelCount("dino")
+              << " -> " << clones->voxelCount("dino") << std::endl;
+    EXPECT_GE(recall[1] / n, recall[0] / n - kFreeSpaceRealRecallLoss);
+    EXPECT_GE(iou[1] / n, iou[0] / n - kFreeSpaceRealIoULoss);
 }
 
 TEST(Augocc_CloneBuilder_FreeSpace, multithread_reproducibility)
