@@ -627,6 +627,36 @@ TEST(Augocc_CloneBuilder, cli_clone_and_matte)
     EXPECT_EQ(runCommand(bin + " clone --reconstruction " + dir + "/rec.yml --masks " + dir +
                          "/masks --out " + dir + "/c4.yml.gz --orientation 1,2", &out), 2);
     EXPECT_NE(out.find("--orientation"), std::string::npos) << out;
+    // --tracks: the points' observations (exact projections here); free space on by default,
+    // --no-free-space keeps the silhouettes-only clone; tracks that do not match the points: 2.
+    {
+        const int F = (int)s.rec.cameras.size(), P = s.rec.points.rows;
+        Tracks t;
+        t.imageSize = s.rec.imageSize;
+        t.tracks = Mat(F, P, CV_32FC2);
+        for (int f = 0; f < F; f++)
+            for (int p = 0; p < P; p++)
+            {
+                const Point2d q = s.rec.project(f, Vec3d(s.rec.points.ptr<double>(p)));
+                t.tracks.at<Vec2f>(f, p) = Vec2f((float)q.x, (float)q.y);
+            }
+        writeTracks(dir + "/tracks.yml", t);
+        t.tracks = t.tracks.colRange(0, P / 2).clone();
+        writeTracks(dir + "/half.yml", t);
+    }
+    ASSERT_EQ(runCommand(bin + " --quiet clone --reconstruction " + dir + "/rec.yml --masks " + dir +
+                         "/masks --out " + dir + "/t1.yml.gz --tracks " + dir + "/tracks.yml", &out),
+              0) << out;
+    ASSERT_EQ(runCommand(bin + " --quiet clone --reconstruction " + dir + "/rec.yml --masks " + dir +
+                         "/masks --out " + dir + "/t2.yml.gz --tracks " + dir +
+                         "/tracks.yml --no-free-space", &out), 0) << out;
+    for (const char* name : {"tower", "ell"})
+        EXPECT_LE(CloneSet::load(dir + "/t1.yml.gz")->voxelCount(name),
+                  CloneSet::load(dir + "/t2.yml.gz")->voxelCount(name)) << name;
+    EXPECT_EQ(runCommand(bin + " clone --reconstruction " + dir + "/rec.yml --masks " + dir +
+                         "/masks --out " + dir + "/t3.yml.gz --tracks " + dir + "/half.yml", &out), 2);
+    EXPECT_NE(out.find("tracks"), std::string::npos) << out;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/t3.yml.gz"));
     // --input: photo-consistency carving over the frames (uniform frames: nothing to carve).
     std::filesystem::create_directories(dir + "/frames");
     std::filesystem::create_directories(dir + "/few");
