@@ -749,12 +749,11 @@ int64 dropUnseenVoxels(ObjectClone& obj, const Reconstruction& rec)
     return dropped;
 }
 
-void recomputePatches(std::map<String, ObjectClone>& objs, ObjectClone& obj,
-                      const Reconstruction& rec, bool occlusionAware, int raysPerPixel);
-
-void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
-                   const Reconstruction& rec, const std::vector<int>& carveFrames,
-                   bool occlusionAware, int raysPerPixel)
+// Step 4 with the key frames `carveFrames`: carving, the unseen voxels, the surface (the patches
+// are the caller's: Step 5 comes once every carve is done).
+void carveObject(std::map<String, ObjectClone>& objs, ObjectClone& obj,
+                 const Reconstruction& rec, const std::vector<int>& carveFrames,
+                 bool occlusionAware)
 {
     std::vector<CarveView> views(carveFrames.size());
     parallel_for_(Range(0, (int)carveFrames.size()), [&](const Range& r) {
@@ -779,7 +778,6 @@ void carveAndPatch(std::map<String, ObjectClone>& objs, ObjectClone& obj,
         }
     }
     obj.surface = obj.grid.surface();
-    recomputePatches(objs, obj, rec, occlusionAware, raysPerPixel);
 }
 
 // Step 5 for every key frame (the clone changed, so every patch set is redone).
@@ -865,14 +863,13 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
             m.second = m.second.clone();
         makeGrid(obj, box, rec);
     }
-    // Steps 4-5 per object (unknown pixels need every object's centre).
+    // Step 4 per object (unknown pixels need every object's centre).
     for (auto& o : set->objects)
     {
         std::vector<int> frames;
         for (const auto& m : o.second.masks)
             frames.push_back(m.first);
-        carveAndPatch(set->objects, o.second, rec, frames, params_.occlusionAware,
-                      params_.raysPerPixel);
+        carveObject(set->objects, o.second, rec, frames, params_.occlusionAware);
     }
     // Beyond the paper: the free space the tracks show.
     if (tracks && params_.freeSpaceMinViews > 0)
@@ -882,13 +879,15 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
         fp.edgeMargin = params_.freeSpaceEdgeMargin;
         for (const auto& c : freeSpaceCarve(*set, rec, *tracks, members, fp))
         {
+            CV_UNUSED(c);  // with the debug log compiled out
             CV_LOG_DEBUG(NULL, cv::format("augocc: object '%s': %lld voxels carved by free space",
                          c.first.c_str(), (long long)c.second));
-            if (c.second > 0)
-                recomputePatches(set->objects, set->get(c.first), rec, params_.occlusionAware,
-                                 params_.raysPerPixel);
         }
     }
+    // Step 5 per object.
+    for (auto& o : set->objects)
+        recomputePatches(set->objects, o.second, rec, params_.occlusionAware,
+                         params_.raysPerPixel);
     return set;
 }
 
@@ -903,8 +902,8 @@ void CloneBuilderImpl::addKeyFrame(CloneSet& clones, const Reconstruction& rec,
     Mat m = mask.getMat();
     checkMask(m, rec, object, frame);
     obj.masks[frame] = m > 127;
-    carveAndPatch(set->objects, obj, rec, std::vector<int>(1, frame), params_.occlusionAware,
-                  params_.raysPerPixel);
+    carveObject(set->objects, obj, rec, std::vector<int>(1, frame), params_.occlusionAware);
+    recomputePatches(set->objects, obj, rec, params_.occlusionAware, params_.raysPerPixel);
 }
 
 int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
