@@ -3,8 +3,8 @@
 
 // Free-space carving of the clones from the tracks (beyond the paper). A point tracked in frame f
 // is seen there, so the line of sight between the camera and the point is empty: the visibility
-// constraint of surface reconstruction from structure from motion (Faugeras, Le Bras-Mehlman &
-// Boissonnat 1990; Labatut, Pons & Keriven 2007). Single lines of sight are too sparse to carve a
+// constraint of surface reconstruction from structure from motion (@cite Faugeras1990;
+// @cite Labatut2007). Single lines of sight are too sparse to carve a
 // solid volume (a voxel's rays hit a feature in about one frame in 300 on the synthesized
 // scene), so, as those methods do with their triangulations, the free space is spread over the
 // Delaunay triangles of an object's points in the image: a triangle is taken as empty in front
