@@ -143,11 +143,7 @@ std::map<String, int64> freeSpaceCarve(CloneSetImpl& set, const Reconstruction& 
     std::map<String, int64> carved;
     if (rec.points.empty() || params.minViews <= 0)
         return carved;
-    std::vector<const Camera*> cams;
-    const int nc = (int)rec.cameras.size();
-    const int nv = params.maxViews > 0 ? std::min(params.maxViews, nc) : nc;
-    for (int q = 0; q < nv; q++)
-        cams.push_back(&rec.cameras[nv > 1 ? (int)((int64)q * (nc - 1) / (nv - 1)) : 0]);
+    const std::vector<const Camera*> cams = evenlySpacedCameras(rec, params.maxViews);
     for (auto& o : set.objects)
     {
         ObjectClone& obj = o.second;
@@ -193,8 +189,6 @@ std::map<String, int64> freeSpaceCarve(CloneSetImpl& set, const Reconstruction& 
             wave.push_back(Vec3i(i, j, k));
             queued[g.index(i, j, k)] = 1;
         }
-        static const int nb[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0},
-                                     {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
         KeyFrameCoverage cov(g, obj, rec);
         int64 n = 0;
         std::vector<uchar> answer;
@@ -213,16 +207,13 @@ std::map<String, int64> freeSpaceCarve(CloneSetImpl& set, const Reconstruction& 
                     !cov.isSurface(v[0], v[1], v[2]) || !cov.tryCarve(v[0], v[1], v[2]))
                     continue;
                 n++;
-                for (int e = 0; e < 6; e++)
+                for (const Vec3i& e : cov.exposed())
                 {
-                    const int a = v[0] + nb[e][0], b = v[1] + nb[e][1], c = v[2] + nb[e][2];
-                    if (!g.inside(a, b, c))
-                        continue;
-                    const size_t idx = g.index(a, b, c);
-                    if (g.data[idx] && !queued[idx])
+                    const size_t idx = g.index(e[0], e[1], e[2]);
+                    if (!queued[idx])
                     {
                         queued[idx] = 1;
-                        next.push_back(Vec3i(a, b, c));
+                        next.push_back(e);
                     }
                 }
             }

@@ -2,7 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 // Carving beyond the visual hull (photo-consistency, free space) under the key-frame silhouettes'
-// protection: the bookkeeping both carvers share.
+// protection: what both carvers share (the frames they use, the key-frame cover bookkeeping).
 
 #ifndef OPENCV_AUGOCC_KEY_FRAME_COVERAGE_HPP
 #define OPENCV_AUGOCC_KEY_FRAME_COVERAGE_HPP
@@ -12,6 +12,18 @@
 namespace cv {
 namespace augocc {
 namespace detail {
+
+//! At most maxViews cameras (0: all), evenly spaced over the reconstruction's (fixed indices: the
+//! same for any thread count).
+inline std::vector<const Camera*> evenlySpacedCameras(const Reconstruction& rec, int maxViews)
+{
+    const int total = (int)rec.cameras.size();
+    const int n = maxViews > 0 ? std::min(total, maxViews) : total;
+    std::vector<const Camera*> use(n);
+    for (int c = 0; c < n; c++)
+        use[c] = &rec.cameras[n > 1 ? (int)((int64)c * (total - 1) / (n - 1)) : 0];
+    return use;
+}
 
 // Key-frame protection: per key frame, how many surface voxels' footprints cover each pixel. The
 // union of the surface's footprints is the clone's matte (the renderer draws only the surface),
@@ -55,7 +67,8 @@ public:
     }
 
     /** Carves voxel (i, j, k) (inside, on the surface) unless a key-frame silhouette pixel would
-    lose its last cover; the neighbours it exposes join the surface. True when carved. */
+    lose its last cover; the neighbours it exposes join the surface (exposed()). True when
+    carved. */
     bool tryCarve(int i, int j, int k)
     {
         static const int nb[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0},
@@ -99,6 +112,9 @@ public:
         g_.data[g_.index(i, j, k)] = 0;
         return true;
     }
+
+    //! The voxels the last successful tryCarve() brought to the surface.
+    const std::vector<Vec3i>& exposed() const { return exposed_; }
 
 private:
     void add(size_t q, int i, int j, int k, int d)

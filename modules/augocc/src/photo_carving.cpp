@@ -315,13 +315,9 @@ std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstruction& rec,
                                    const std::vector<Mat>& frames, const PhotoCarveParams& p)
 {
     const std::vector<String> names = set.objectNames();
-    // The cameras compared: at most maxViews, evenly spaced over the reconstruction's (fixed
-    // indices: the same for any thread count).
-    const int total = (int)rec.cameras.size();
-    const int nc = p.maxViews > 0 ? std::min(total, p.maxViews) : total;
-    std::vector<const Camera*> use(nc);
-    for (int c = 0; c < nc; c++)
-        use[c] = &rec.cameras[nc > 1 ? (int)((int64)c * (total - 1) / (nc - 1)) : 0];
+    // The cameras compared.
+    const std::vector<const Camera*> use = evenlySpacedCameras(rec, p.maxViews);
+    const int nc = (int)use.size();
     const int no = (int)names.size();
     const Size size = rec.imageSize;
     std::map<String, int64> carved;
