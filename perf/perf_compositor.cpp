@@ -42,6 +42,7 @@ void Augocc_Compositor_composite(benchmark::State& state)
     CompositeInputs in = makeInputs(size, k);
     Compositor::Params p;
     p.supersample = k;
+    p.antialiasVirtual = state.range(3) != 0;
     Ptr<Compositor> comp = Compositor::create(p);
     comp->setVirtualObjects({in.sphere});
     Mat result;
@@ -55,8 +56,9 @@ void Augocc_Compositor_composite(benchmark::State& state)
         state.SkipWithError("empty composite");
 }
 BENCHMARK(Augocc_Compositor_composite)->Name("Augocc_Compositor/composite_100k_tris")
-    ->ArgNames({"w", "h", "supersample"})
-    ->Args({640, 480, 1})->Args({1280, 720, 1})->Args({640, 480, 3})->Args({1280, 720, 3})
+    ->ArgNames({"w", "h", "supersample", "antialias_virtual"})
+    ->Args({640, 480, 1, 0})->Args({1280, 720, 1, 0})->Args({640, 480, 3, 0})
+    ->Args({1280, 720, 3, 0})->Args({640, 480, 3, 1})->Args({1280, 720, 3, 1})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace

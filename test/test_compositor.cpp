@@ -147,32 +147,50 @@ TEST_P(Augocc_Compositor_P, accuracy_occlusion)
 }
 
 // Soft edges: with 4x supersampling an occluder edge that splits pixel column 95 in half gives
-// that column alpha 1/2, columns left of it 0 (hidden) and right of it 1.
+// that column alpha 1/2, columns left of it 0 (hidden) and right of it 1, whether the virtual
+// objects are drawn at 4x too (antialiasVirtual) or at the frame grid.
 TEST_P(Augocc_Compositor_P, accuracy_soft_edge_coverage)
 {
     const Camera cam = makeCamera((CameraModel)GetParam());
-    Compositor::Params p;
-    p.supersample = 4;
-    p.edgeRadius = 0;  // the supersampled depth test alone
-    Ptr<Compositor> comp = Compositor::create(p);
-    comp->setVirtualObjects({makeQuad(Vec3f(0.5f, 0.5f, 0.5f), Vec3f(0.2f, 0.2f, 0.2f))});
-    const Size rsz = comp->renderSize(kSize);
-    ASSERT_EQ(rsz, Size(640, 480));
-    Mat occ(rsz, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
-    occ.colRange(0, 4 * 95 + 2).setTo(5.0);
-    Mat result, layer;
-    comp->composite(makeFrame(), cam, occ, result, layer);
-    std::vector<Mat> ch;
-    cv::split(layer, ch);
-    const Mat& a = ch[3];
-    // Box average of 4x4 samples, 8-bit rounding: 128 +- 1.
-    EXPECT_NEAR(a.at<uchar>(60, 95), 128, 1);
-    EXPECT_EQ(a.at<uchar>(60, 94), 0);
-    EXPECT_EQ(a.at<uchar>(60, 96), 255);
-    // The quad's own outline is anti-aliased too: its edge columns are fully covered (edges at
-    // u = 49.7 and 110.3 cover 3 of 4 sub-columns... of pixels 50 and 110 minus the border).
-    EXPECT_GT(a.at<uchar>(60, 110), 0);
-    EXPECT_LT(a.at<uchar>(60, 111), 255);
+    for (bool aa : {false, true})
+    {
+        Compositor::Params p;
+        p.supersample = 4;
+        p.antialiasVirtual = aa;
+        p.edgeRadius = 0;  // the supersampled depth test alone
+        Ptr<Compositor> comp = Compositor::create(p);
+        comp->setVirtualObjects({makeQuad(Vec3f(0.5f, 0.5f, 0.5f), Vec3f(0.2f, 0.2f, 0.2f))});
+        const Size rsz = comp->renderSize(kSize);
+        ASSERT_EQ(rsz, Size(640, 480));
+        Mat occ(rsz, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+        occ.colRange(0, 4 * 95 + 2).setTo(5.0);
+        Mat result, layer, depth;
+        comp->composite(makeFrame(), cam, occ, result, layer, depth);
+        std::vector<Mat> ch;
+        cv::split(layer, ch);
+        const Mat& a = ch[3];
+        // Box average of 4x4 samples, 8-bit rounding: 128 +- 1.
+        EXPECT_NEAR(a.at<uchar>(60, 95), 128, 1) << aa;
+        EXPECT_EQ(a.at<uchar>(60, 94), 0) << aa;
+        EXPECT_EQ(a.at<uchar>(60, 96), 255) << aa;
+        // Depth output: the nearest of each pixel's samples, the occluder's in column 95.
+        EXPECT_FLOAT_EQ(depth.at<float>(60, 95), 5.f) << aa;
+        if (aa)
+        {
+            // The quad's own outline is anti-aliased too (its edge at u = 110.3 covers part of
+            // pixel 111's samples)...
+            EXPECT_GT(a.at<uchar>(60, 110), 0);
+            EXPECT_LT(a.at<uchar>(60, 111), 255);
+        }
+        else
+        {
+            // ... or drawn at the frame grid, as with hard edges: every pixel of the quad is
+            // whole (0 or 255) away from the occluder.
+            Mat partial = (a > 0) & (a < 255);
+            partial.colRange(94, 97).setTo(0);
+            EXPECT_EQ(countNonZero(partial), 0);
+        }
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(/**/, Augocc_Compositor_P,

@@ -239,6 +239,7 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
             cp.supersample = k;
             cp.edgeRadius = v.r;
             cp.edgeEps = v.eps;
+            cp.antialiasVirtual = getenv("AUGOCC_ANTIALIAS_VIRTUAL") != nullptr;
             Ptr<Compositor> comp = Compositor::create(cp);
             comp->setVirtualObjects(meshes);
             double band = 0, bnd = 0;

@@ -16,6 +16,7 @@ struct CompositeCliOptions
 {
     std::string input, reconstruction, clones, scene, out, frames, mattes, depth, layer;
     bool hardEdges = false;
+    bool antialiasVirtual = false;
 };
 
 void runComposite(const Globals& g, const CompositeCliOptions& o)
@@ -41,6 +42,7 @@ void runComposite(const Globals& g, const CompositeCliOptions& o)
     const VirtualScene scene = readScene(o.scene);
     const std::vector<Mesh> meshes = placeScene(scene, rec, clones.get());
     opt.supersample = o.hardEdges ? 1 : Compositor::Params().supersample;
+    opt.antialiasVirtual = o.antialiasVirtual;
     opt.mattesDir = o.mattes;
     opt.depthDir = o.depth;
     opt.virtualLayerDir = o.layer;
@@ -78,6 +80,8 @@ void registerComposite(CLI::App& app, Globals& g)
                     "BGRA");
     sub->add_flag("--hard-edges", o->hardEdges, "the paper's per-pixel depth test (no soft "
                   "occlusion edges)");
+    sub->add_flag("--antialias-virtual", o->antialiasVirtual, "also anti-alias the virtual "
+                  "objects' own outlines (renders them at 3x: slower)")->excludes("--hard-edges");
     sub->callback([&g, o]() { runComposite(g, *o); });
 }
 

@@ -33,6 +33,7 @@ struct RunCliOptions
 {
     std::string input, masks, scene, outDir;
     bool hardEdges = false;
+    bool antialiasVirtual = false;
     bool noPhotoRefine = false;
 };
 
@@ -47,6 +48,7 @@ void runRun(const Globals& g, const RunCliOptions& o)
     ro.scenePath = o.scene;
     ro.outDir = o.outDir;
     ro.supersample = o.hardEdges ? 1 : Compositor::Params().supersample;
+    ro.antialiasVirtual = o.antialiasVirtual;
     ro.photoRefine = !o.noPhotoRefine;
     std::shared_ptr<Progress> current;
     auto stage = std::make_shared<std::string>();
@@ -74,6 +76,8 @@ void registerRun(CLI::App& app, Globals& g)
     sub->add_option("--out-dir", o->outDir, "folder for every intermediate and the composite")
         ->required();
     sub->add_flag("--hard-edges", o->hardEdges, "the paper's per-pixel depth test");
+    sub->add_flag("--antialias-virtual", o->antialiasVirtual, "also anti-alias the virtual "
+                  "objects' own outlines (renders them at 3x: slower)")->excludes("--hard-edges");
     sub->add_flag("--no-photo-refine", o->noPhotoRefine, "clones from the silhouettes alone (no "
                   "photo-consistency carving over the frames)");
     sub->callback([&g, o]() { runRun(g, *o); });

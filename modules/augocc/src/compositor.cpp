@@ -44,7 +44,7 @@ Camera supersampledCamera(const Camera& camera, int factor)
 }
 
 Compositor::Params::Params()
-    : supersample(3), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2),
+    : supersample(3), antialiasVirtual(false), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2),
       lightRotation(Matx33d::eye())
 {
 }
@@ -242,12 +242,11 @@ public:
             cloneOcc_.setTo(Scalar::all(inf));
             renderClones(Rect(Point(), rsz), cloneOcc_);
             const Mat occRoi = pl.roi.area() > 0 ? cloneOcc_(pl.roi) : Mat();
-            compositeCore(frame, camera, pl, [&](const Mat&) { return occRoi; }, cloneOcc_,
+            compositeCore(frame, camera, pl, [&](const Rect&) { return occRoi; }, cloneOcc_,
                           result, virtualLayer, depthOut);
             return;
         }
-        auto occluderOf = [&](const Mat& rgbaUp) {
-            const Rect cov = coveredRect(rgbaUp);
+        auto occluderOf = [&](const Rect& cov) {
             if (cov.area() == 0)
                 return Mat();
             cloneOcc_.create(pl.roi.size(), CV_32F);
@@ -285,7 +284,7 @@ public:
         }
         const FramePlan pl = plan(camera, rsz);
         const Mat occRoi = (occ.empty() || pl.roi.area() == 0) ? Mat() : occ(pl.roi);
-        compositeCore(frame, camera, pl, [&](const Mat&) { return occRoi; }, occ, result,
+        compositeCore(frame, camera, pl, [&](const Rect&) { return occRoi; }, occ, result,
                       virtualLayer, depthOut);
     }
 
@@ -357,19 +356,26 @@ private:
         return Rect(r.x, rgbaUp.rows - r.y - r.height, r.width, r.height);
     }
 
-    // Draws, reads back, resolves against the occluder and blends. occluderOf(rgbaUp): the
-    // occluder depth over pl.roi, right at least at the samples rgbaUp covers (empty: nothing
-    // occludes); occFull: over the render grid, for the depth output only (empty: nothing).
+    // Draws, reads back, resolves against the occluder and blends. occluderOf(cov): the
+    // occluder depth over pl.roi (render grid), right at least in `cov`, the rectangle of pl.roi
+    // the virtual objects cover (empty: nothing occludes); occFull: over the render grid, for
+    // the depth output only (empty: nothing). The virtual objects are drawn at the render grid
+    // (antialiasVirtual) or at the frame grid, each pixel's depth then tested against its k x k
+    // occluder samples.
     void compositeCore(const Mat& frame, const Camera& camera, const FramePlan& pl,
-                       const std::function<Mat(const Mat&)>& occluderOf, const Mat& occFull,
+                       const std::function<Mat(const Rect&)>& occluderOf, const Mat& occFull,
                        OutputArray result, OutputArray virtualLayer, OutputArray depthOut)
     {
         const int k = params_.supersample;
         const Size fsz = frame.size();
         const Size rsz = renderSize(fsz);
-        ensureContext(rsz);
+        // g: the grid the virtual objects are drawn at, in samples per frame pixel.
+        const int g = params_.antialiasVirtual ? k : 1;
+        const Size gsz(fsz.width * g, fsz.height * g);
+        ensureContext(gsz);
         uploadIfDirty();
-        const Rect& roi = pl.roi;
+        const Rect roi(pl.roi.x / k * g, pl.roi.y / k * g, pl.roi.width / k * g,
+                       pl.roi.height / k * g);
         const double zNear = pl.zNear, zFar = pl.zFar;
 
         // layerRoi_: frame grid, ROI only: premultiplied RGB + alpha, CV_32FC4, top-down.
@@ -378,14 +384,14 @@ private:
         const bool needZ = depthOut.needed();
         if (roi.area() > 0)
         {
-            const int winY = rsz.height - roi.y - roi.height;
+            const int winY = gsz.height - roi.y - roi.height;
             // A clear of the whole buffer (colour, depth and stencil together) is a fast clear in
             // llvmpipe; a scissored one draws a quad through the fragment shader. Only the ROI is
             // read, so either is right: the fast one while the ROI is a good part of the buffer.
             glClearColor(0, 0, 0, 0);
             glClearDepth(1.0);
             glClearStencil(0);
-            const bool wholeClear = 4 * (double)roi.area() >= (double)rsz.area();
+            const bool wholeClear = 4 * (double)roi.area() >= (double)gsz.area();
             if (wholeClear)
                 glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
             glEnable(GL_SCISSOR_TEST);
@@ -396,7 +402,7 @@ private:
             glDisable(GL_BLEND);
             glDisable(GL_DITHER);
             glEnable(GL_DEPTH_TEST);
-            drawMeshes(pl.rc, rsz, zNear, zFar);
+            drawMeshes(g == k ? pl.rc : camera, gsz, zNear, zFar);
             // glReadPixels waits for the rasteriser itself: no glFinish. RGBA bytes are the
             // buffer's own format (a plain copy in Mesa); the channel order is handled in
             // resolve().
@@ -408,15 +414,22 @@ private:
             glReadPixels(roi.x, winY, roi.width, roi.height, GL_DEPTH_COMPONENT, GL_FLOAT,
                          depthUp_.data);
             glDisable(GL_SCISSOR_TEST);
-            frameRoi_ = frame(Rect(roi.x / k, roi.y / k, roi.width / k, roi.height / k));
-            const Mat occRoi = occluderOf(rgbaUp_);
-            resolve(camera, rgbaUp_, depthUp_, occRoi, zNear, zFar, k, needZ, layerRoi_, zRoi_);
+            frameRoi_ = frame(Rect(roi.x / g, roi.y / g, roi.width / g, roi.height / g));
+            const Rect cov = coveredRect(rgbaUp_);
+            const Mat occRoi = occluderOf(g == k ? cov : Rect(cov.x * k, cov.y * k,
+                                                              cov.width * k, cov.height * k));
+            if (g == k)
+                resolve(camera, rgbaUp_, depthUp_, occRoi, zNear, zFar, k, needZ, layerRoi_,
+                        zRoi_);
+            else
+                resolveEdges(camera, rgbaUp_, depthUp_, occRoi, zNear, zFar, k, needZ,
+                             layerRoi_, zRoi_);
         }
-        const Rect froi(roi.x / k, roi.y / k, roi.width / k, roi.height / k);
+        const Rect froi(pl.roi.x / k, pl.roi.y / k, pl.roi.width / k, pl.roi.height / k);
         blend(frame, layerRoi_, froi, result, virtualLayer);
         frameRoi_ = Mat();
         if (needZ)
-            writeDepth(occFull, zRoi_, roi, rsz, fsz, k, depthOut);
+            writeDepth(occFull, zRoi_, pl.roi, rsz, fsz, k, depthOut);
     }
 
     void ensureContext(Size rsz)
@@ -704,6 +717,74 @@ private:
                         all[x] = Vec4f(t[4] * inv, t[5] * inv, t[6] * inv, t[7] * inv);
                         vf[x] = t[7] > 0 ? t[3] / t[7] : 1.f;
                     }
+                }
+            }
+        });
+        if (refine)
+            refineOcclusion(visFrac_, allColor_, layer);
+    }
+
+    // resolve() for virtual objects drawn at the frame grid (rgbaUp, depthUp: frame grid, GL rows
+    // bottom-up) and the occluder at k x: a covered pixel's camera z is tested against its k x k
+    // occluder samples, and its colour weighted by the fraction in front. zVirtual (render grid)
+    // repeats the pixel's z over its samples.
+    void resolveEdges(const Camera& cam, const Mat& rgbaUp, const Mat& depthUp, const Mat& occ,
+                      double zNear, double zFar, int k, bool needZ, Mat& layer, Mat& zVirtual)
+    {
+        const Size sz = rgbaUp.size();
+        const bool ortho = cam.model == SCALED_ORTHOGRAPHIC;
+        const float inf = std::numeric_limits<float>::infinity();
+        const bool refine = !occ.empty() && params_.edgeRadius > 0 && frameRoi_.data;
+        if (needZ)
+            zVirtual.create(sz.height * k, sz.width * k, CV_32F);
+        layer.create(sz, CV_32FC4);
+        if (refine)
+        {
+            visFrac_.create(sz, CV_32F);
+            allColor_.create(sz, CV_32FC4);
+        }
+        const float inv255 = 1.f / 255.f, invSamples = 1.f / (float)(k * k);
+        const double zSum = zFar + zNear, zDiff = zFar - zNear, zProd2 = 2 * zFar * zNear;
+        cv::parallel_for_(Range(0, sz.height), [&](const Range& r) {
+            for (int y = r.start; y < r.end; y++)
+            {
+                const float* d = depthUp.ptr<float>(sz.height - 1 - y);
+                const uchar* c = rgbaUp.ptr<uchar>(sz.height - 1 - y);
+                Vec4f* out = layer.ptr<Vec4f>(y);
+                for (int x = 0; x < sz.width; x++)
+                {
+                    const uchar* cx = c + 4 * x;
+                    float z = inf, frac = 0.f;
+                    if (cx[3] != 0)
+                    {
+                        const double ndc = 2.0 * d[x] - 1.0;
+                        z = ortho ? (float)(0.5 * (ndc * zDiff + zSum))
+                                  : (float)(zProd2 / (zSum - ndc * zDiff));
+                        int visible = k * k;
+                        if (!occ.empty())
+                            for (int j = 0; j < k; j++)
+                            {
+                                const float* zo = occ.ptr<float>(y * k + j) + x * k;
+                                for (int i = 0; i < k; i++)
+                                    visible -= zo[i] < z;  // a real object is in front
+                            }
+                        frac = visible * invSamples;
+                    }
+                    const Vec4f all(cx[2] * inv255, cx[1] * inv255, cx[0] * inv255,
+                                    cx[3] != 0 ? 1.f : 0.f);
+                    out[x] = all * frac;
+                    if (refine)
+                    {
+                        allColor_.at<Vec4f>(y, x) = all;
+                        visFrac_.at<float>(y, x) = cx[3] != 0 ? frac : 1.f;
+                    }
+                    if (needZ)
+                        for (int j = 0; j < k; j++)
+                        {
+                            float* zv = zVirtual.ptr<float>(y * k + j) + x * k;
+                            for (int i = 0; i < k; i++)
+                                zv[i] = z;
+                        }
                 }
             }
         });

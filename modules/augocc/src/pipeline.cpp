@@ -231,6 +231,7 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
 
     Compositor::Params cp;
     cp.supersample = options.supersample;
+    cp.antialiasVirtual = options.antialiasVirtual;
     if (options.lightFromGround)
         cp.lightRotation = groundRotation(estimateGround(rec));
     Ptr<Compositor> comp = Compositor::create(cp);
@@ -582,6 +583,7 @@ RunResult runPipeline(const RunOptions& o)
         r.virtualObjects = placeScene(scene, r.reconstruction, r.clones.get());
         CompositeOptions co;
         co.supersample = o.supersample;
+        co.antialiasVirtual = o.antialiasVirtual;
         co.firstFrame = r.reconstruction.cameras.front().frame;
         co.endFrame = r.reconstruction.cameras.back().frame + 1;
         co.progress = [&](int d, int t) { progress("composite", d, t); };

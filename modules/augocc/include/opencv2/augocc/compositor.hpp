@@ -54,6 +54,12 @@ public:
         the paper's hard depth test; 3 makes occlusion edges soft (see doc/compositor.md for the
         measured error). */
         int supersample;
+        /** With supersample k > 1: also render the virtual objects at k x (anti-aliases their
+        own outlines against the frame, at k^2 the rasterising cost). Default false: the virtual
+        layer is rendered at the frame's resolution and only the depth test against the real
+        objects runs at k x k samples per pixel (each against the pixel's virtual depth), which
+        is what makes occlusion edges soft (doc/compositor.md: same edge error, 2.3x faster). */
+        bool antialiasVirtual;
         /** Cull the back faces of meshes that are closed and outward-oriented (checked per mesh
         when uploaded; such back faces are never visible, so no pixel changes). Halves the
         triangles the rasteriser sets up (default true). */

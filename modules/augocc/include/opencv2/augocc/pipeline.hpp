@@ -32,6 +32,7 @@ struct CV_EXPORTS CompositeOptions
     int firstFrame = 0;        //!< first frame composited
     int endFrame = -1;         //!< one past the last frame (-1: the end of the input)
     int supersample = 3;       //!< Compositor::Params::supersample (1: hard edges)
+    bool antialiasVirtual = false;  //!< Compositor::Params::antialiasVirtual
     String mattesDir;          //!< if set: the clones' mattes, `DIR/<object>/%04d.png` (contract)
     /** if set: per frame `DIR/%04d.png`, 16-bit, camera-space z of the nearest surface (clone or
     virtual) as `(value - 1) / scale + offset`, 0 where nothing; `DIR/depth.yml` holds `scale`
@@ -118,6 +119,7 @@ struct CV_EXPORTS RunOptions
     String scenePath;        //!< scene.yml; empty: stop after the mattes
     String outDir;           //!< every intermediate file and the composite go here
     int supersample = 3;     //!< compositor supersampling (1: hard edges)
+    bool antialiasVirtual = false;  //!< Compositor::Params::antialiasVirtual
     //! Carve the clones further by photo-consistency over every frame (CloneBuilder::refine).
     bool photoRefine = true;
     //! Stage progress: (stage name, done, total); a stage starts with done = 0.
