@@ -50,9 +50,9 @@ public:
     struct CV_EXPORTS Params
     {
         Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        /** Supersampling factor of the virtual layer and the occluder depth (default 3). 1 gives
-        the paper's hard depth test; 3 makes occlusion edges soft (see doc/compositor.md for the
-        measured error). */
+        /** Supersampling factor of the depth test against the real objects (default 3): the
+        occluder depth is sampled k x k per pixel. 1 gives the paper's hard depth test; 3 makes
+        occlusion edges soft (see doc/compositor.md for the measured error). */
         int supersample;
         /** With supersample k > 1: also render the virtual objects at k x (anti-aliases their
         own outlines against the frame, at k^2 the rasterising cost). Default false: the virtual
