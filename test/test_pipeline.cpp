@@ -206,6 +206,59 @@ TEST(Augocc_Pipeline, accuracy_demo)
     fs::remove_all(o.outDir);
 }
 
+// Issue 5, edge quality: band error (2 px around the occlusion boundary) against the 4x
+// supersampled truth, soft edges (default compositor, k = 3) against the hard depth test, with
+// the real objects' exact geometry as occluders (MeshClones), so that the figure is the
+// compositor's edge and not the clones' outline (issue 4 measures that). Measured 2026-12-01:
+// 7.56 -> 3.29 (-56%); with built + photo-refined voxel clones 13.91 -> 13.25 (-5%), printed, not
+// asserted (doc/compositor.md).
+const double kMaxSoftOverHardBand = 0.7;  // issue 5: >= 30% lower
+
+TEST(Augocc_Pipeline, accuracy_soft_edges)
+{
+    SceneSynthesizer::Params sp;
+    sp.frames = 30;
+    sp.numKeyFrames = 6;
+    Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
+    SyntheticScene scene;
+    synth->synthesize(scene);
+    Ptr<CloneBuilder> builder = CloneBuilder::create();
+    Ptr<CloneSet> built = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
+    builder->refine(*built, scene.groundTruth, scene.frames);
+    MeshClones exact(scene.objectNames, scene.objectMeshes);
+    const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth,
+                                                built.get());
+    Compositor::Params hp;
+    hp.supersample = 1;
+    Ptr<Compositor> hard = Compositor::create(hp);
+    hard->setVirtualObjects(meshes);
+    Ptr<Compositor> soft = Compositor::create();
+    soft->setVirtualObjects(meshes);
+    double band[2][2] = {{0, 0}, {0, 0}};  // [exact, built][hard, soft]
+    int n = 0;
+    for (int f = 0; f < sp.frames; f += 7)
+    {
+        Mat bg, truth4;
+        synth->renderWithVirtual(f, {}, bg, 4);
+        synth->renderWithVirtual(f, meshes, truth4, 4);
+        for (int c = 0; c < 2; c++)
+            for (int e = 0; e < 2; e++)
+            {
+                Mat result, layer;
+                (e ? soft : hard)->composite(bg, f, scene.groundTruth.camera(f),
+                                             c ? (const CloneSet&)*built : exact, result, layer);
+                band[c][e] += scoreFrame(scene, f, bg, *hard, result, layer, truth4).bandError;
+            }
+        n++;
+    }
+    std::cout << "band error vs 4x truth, hard -> soft: exact clones " << band[0][0] / n << " -> "
+              << band[0][1] / n << ", built clones " << band[1][0] / n << " -> "
+              << band[1][1] / n << std::endl;
+    EXPECT_LE(band[0][1], kMaxSoftOverHardBand * band[0][0]);
+    // Soft edges never make the built clones' edges worse.
+    EXPECT_LE(band[1][1], band[1][0]);
+}
+
 TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
 {
     SceneSynthesizer::Params sp;
