@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "test_precomp.hpp"
+#include <opencv2/calib3d.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -591,6 +592,89 @@ TEST(Augocc_CloneBuilder, middlebury_dino)
         EXPECT_GE(rkeyMin, kKeyFrameMinIoU);
         EXPECT_GE(rsum / 8, sum / 8 + kDinoMinPhotoGain);
     }
+}
+
+// A 3x4 projection matrix (P maps X to (col, row, w)) as a perspective Camera: RQ with a
+// positive diagonal of K, det R = +1.
+Camera cameraFromProjection(const Matx34d& P, int frame)
+{
+    Mat K, R, C;
+    decomposeProjectionMatrix(Mat(P), K, R, C);
+    Matx33d Km(K), Rm(R);
+    for (int a = 0; a < 3; a++)
+        if (Km(a, a) < 0)
+            for (int q = 0; q < 3; q++)
+            {
+                Km(q, a) = -Km(q, a);
+                Rm(a, q) = -Rm(a, q);
+            }
+    if (determinant(Rm) < 0)
+        Rm = -Rm;  // P and -P are the same camera
+    Km *= 1.0 / Km(2, 2);
+    const Vec3d c(C.at<double>(0) / C.at<double>(3), C.at<double>(1) / C.at<double>(3),
+                  C.at<double>(2) / C.at<double>(3));
+    return Camera::perspective(Rm, -(Rm * c), Km, frame);
+}
+
+// The squirrel turntable (36 calibrated 1280x960 photographs on black, silhouettes by HSV value
+// >= 30 as its SOURCE.txt says), every fourth view a key frame, the 27 others held out.
+// Measured 2026-12-01: key frames 1.000; held-out mean IoU 0.958 (worst 0.926), recall 0.994.
+// With the previous last patch round (every voxel of a ray's span that fits) 0.939 / 0.896:
+// rim patches landed at the far end of the grid, streaks in every other view.
+const double kSquirrelMeanIoU = 0.95;
+const double kSquirrelRecall = 0.99;
+
+TEST(Augocc_CloneBuilder, squirrel_turntable_held_out)
+{
+    AUGOCC_REQUIRE_SHARED_DATA(dir, "squirrel_turntable");
+    FileStorage fs(dir + "/viff.xml", FileStorage::READ);
+    ASSERT_TRUE(fs.isOpened());
+    const int n = 36, step = 4;
+    Reconstruction rec;
+    rec.model = PERSPECTIVE;
+    std::vector<Mat> sil(n);
+    for (int f = 0; f < n; f++)
+    {
+        Mat P;
+        fs[cv::format("viff%03d_matrix", f)] >> P;
+        ASSERT_EQ(P.size(), Size(4, 3)) << f;
+        P.convertTo(P, CV_64F);
+        rec.cameras.push_back(cameraFromProjection(Matx34d(P), f));
+        const Mat img = imread(cv::format("%s/image_%d.jpg", dir.c_str(), f));
+        ASSERT_FALSE(img.empty()) << f;
+        rec.imageSize = img.size();
+        Mat hsv, ch[3];
+        cvtColor(img, hsv, COLOR_BGR2HSV);
+        split(hsv, ch);
+        sil[f] = ch[2] >= 30;
+    }
+    ObjectMasks masks;
+    for (int f = 0; f < n; f += step)
+        masks["squirrel"][f] = sil[f];
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(rec, masks);
+    double sum = 0, worst = 1, keyMin = 1, recall = 0;
+    int held = 0;
+    for (int f = 0; f < n; f++)
+    {
+        Mat matte;
+        clones->render("squirrel", f, rec.cameras[f], rec.imageSize, matte);
+        const double iou = maskIoU(matte, sil[f]);
+        if (f % step == 0)
+        {
+            keyMin = std::min(keyMin, iou);
+            continue;
+        }
+        sum += iou;
+        worst = std::min(worst, iou);
+        recall += (double)countNonZero(matte & sil[f]) / countNonZero(sil[f]);
+        held++;
+    }
+    std::cout << "squirrel turntable: grid " << clones->gridSize("squirrel") << ", key frames min "
+              << "IoU " << keyMin << ", " << held << " held-out views mean IoU " << sum / held
+              << " worst " << worst << ", recall " << recall / held << std::endl;
+    EXPECT_GE(keyMin, kKeyFrameMinIoU);
+    EXPECT_GE(sum / held, kSquirrelMeanIoU);
+    EXPECT_GE(recall / held, kSquirrelRecall);
 }
 
 // augocc clone and augocc matte end to end, and their bad-input exits.
