@@ -128,6 +128,35 @@ CompositeScore scoreFrame(const SyntheticScene& scene, int f, const Mat& bg, Com
     return scoreComposite(result, truth, ch[3], rch[3] > 0, sch[3] > 0);
 }
 
+// The 30-frame synthesized scene of the compositing tests (6 key frames, GT cameras) and its
+// clones, built from the key-frame masks and the tracks, photo-refined when `refine`.
+struct CompositingScene
+{
+    Ptr<SceneSynthesizer> synth;
+    SyntheticScene scene;
+};
+
+CompositingScene makeCompositingScene()
+{
+    SceneSynthesizer::Params sp;
+    sp.frames = 30;
+    sp.numKeyFrames = 6;
+    CompositingScene c;
+    c.synth = SceneSynthesizer::create(sp);
+    c.synth->synthesize(c.scene);
+    return c;
+}
+
+Ptr<CloneSet> buildClones(const SyntheticScene& scene, bool refine,
+                          const CloneBuilder::Params& params = CloneBuilder::Params())
+{
+    Ptr<CloneBuilder> builder = CloneBuilder::create(params);
+    Ptr<CloneSet> clones = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
+    if (refine)
+        builder->refine(*clones, scene.groundTruth, scene.frames);
+    return clones;
+}
+
 // Issue 5 with GT cameras: clones built from the key-frame masks and the tracks (free space),
 // refined by photo-consistency, the default compositor (soft edges, k = 3), the demo's dome and
 // tree; every third of 30 frames against the synthesizer's ground truth (1x render).
@@ -139,15 +168,11 @@ const double kGtMaxBoundaryPx = 1.0;   // issue 5
 
 TEST(Augocc_Pipeline, accuracy_gt_cameras_built_clones)
 {
-    SceneSynthesizer::Params sp;
-    sp.frames = 30;
-    sp.numKeyFrames = 6;
-    Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
-    SyntheticScene scene;
-    synth->synthesize(scene);
-    Ptr<CloneBuilder> builder = CloneBuilder::create();
-    Ptr<CloneSet> clones = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
-    builder->refine(*clones, scene.groundTruth, scene.frames);
+    const CompositingScene cs = makeCompositingScene();
+    const Ptr<SceneSynthesizer>& synth = cs.synth;
+    const SyntheticScene& scene = cs.scene;
+    const int frames = (int)scene.frames.size();
+    Ptr<CloneSet> clones = buildClones(scene, true);
     const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth,
                                                 clones.get());
     Ptr<Compositor> comp = Compositor::create();
@@ -158,7 +183,7 @@ TEST(Augocc_Pipeline, accuracy_gt_cameras_built_clones)
     ref->setVirtualObjects(meshes);
     Scores acc;
     int withBoundary = 0;
-    for (int f = 0; f < sp.frames; f += 3)
+    for (int f = 0; f < frames; f += 3)
     {
         Mat result, layer, truth;
         comp->composite(scene.frames[f], f, scene.groundTruth.camera(f), *clones, result, layer);
@@ -216,15 +241,11 @@ const double kMaxSoftOverHardBand = 0.7;  // issue 5: >= 30% lower
 
 TEST(Augocc_Pipeline, accuracy_soft_edges)
 {
-    SceneSynthesizer::Params sp;
-    sp.frames = 30;
-    sp.numKeyFrames = 6;
-    Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
-    SyntheticScene scene;
-    synth->synthesize(scene);
-    Ptr<CloneBuilder> builder = CloneBuilder::create();
-    Ptr<CloneSet> built = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
-    builder->refine(*built, scene.groundTruth, scene.frames);
+    const CompositingScene cs = makeCompositingScene();
+    const Ptr<SceneSynthesizer>& synth = cs.synth;
+    const SyntheticScene& scene = cs.scene;
+    const int frames = (int)scene.frames.size();
+    Ptr<CloneSet> built = buildClones(scene, true);
     MeshClones exact(scene.objectNames, scene.objectMeshes);
     const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth,
                                                 built.get());
@@ -236,7 +257,7 @@ TEST(Augocc_Pipeline, accuracy_soft_edges)
     soft->setVirtualObjects(meshes);
     double band[2][2] = {{0, 0}, {0, 0}};  // [exact, built][hard, soft]
     int n = 0;
-    for (int f = 0; f < sp.frames; f += 7)
+    for (int f = 0; f < frames; f += 7)
     {
         Mat bg, truth4;
         synth->renderWithVirtual(f, {}, bg, 4);
@@ -261,19 +282,15 @@ TEST(Augocc_Pipeline, accuracy_soft_edges)
 
 TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
 {
-    SceneSynthesizer::Params sp;
-    sp.frames = 30;
-    sp.numKeyFrames = 6;
-    Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
-    SyntheticScene scene;
-    synth->synthesize(scene);
+    const CompositingScene cs = makeCompositingScene();
+    const Ptr<SceneSynthesizer>& synth = cs.synth;
+    const SyntheticScene& scene = cs.scene;
+    const int frames = (int)scene.frames.size();
     CloneBuilder::Params bp;
     if (getenv("AUGOCC_VOXEL_PIXELS"))  // voxel edge of the built clones, in pixels
         bp.voxelPixels = atof(getenv("AUGOCC_VOXEL_PIXELS"));
-    Ptr<CloneBuilder> builder = CloneBuilder::create(bp);
-    Ptr<CloneSet> built = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
-    Ptr<CloneSet> refined = builder->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
-    builder->refine(*refined, scene.groundTruth, scene.frames);
+    Ptr<CloneSet> built = buildClones(scene, false, bp);
+    Ptr<CloneSet> refined = buildClones(scene, true, bp);
     MeshClones exact(scene.objectNames, scene.objectMeshes);
     const std::vector<Mesh> meshes = placeScene(demoVirtualScene("demo"), scene.groundTruth, built.get());
     Compositor::Params hp;
@@ -297,7 +314,7 @@ TEST(Augocc_Pipeline, DISABLED_edge_quality_experiment)
             comp->setVirtualObjects(meshes);
             double band = 0, bnd = 0;
             int n = 0;
-            for (int f = 0; f < sp.frames; f += 7)
+            for (int f = 0; f < frames; f += 7)
             {
                 Mat bg, truth4, result, layer;
                 synth->renderWithVirtual(f, {}, bg, 4);
