@@ -711,6 +711,28 @@ TEST(Augocc_CloneBuilder, cli_clone_and_matte)
     EXPECT_EQ(runCommand(bin + " clone --reconstruction " + dir + "/rec.yml --masks " + dir +
                          "/masks --out " + dir + "/c4.yml.gz --orientation 1,2", &out), 2);
     EXPECT_NE(out.find("--orientation"), std::string::npos) << out;
+    // Key-frame masks that disagree (a block marked in one key frame that the others leave
+    // out): the build succeeds, patches keep that frame exact, and a warning names the frame.
+    {
+        ObjectMasks odd = s.keyMasks;
+        const int kf = s.keyFrames.front();
+        Mat& m = odd["tower"][kf];
+        const int side = (int)std::ceil(std::sqrt(0.2 * countNonZero(m)));
+        const Rect r = boundingRect(m);
+        const Rect block(r.br().x + 2, r.y + r.height / 2 - side / 2, side, side);
+        ASSERT_EQ(block & Rect(Point(), m.size()), block);
+        m(block).setTo(255);
+        writeMasks(dir + "/odd", odd);
+        ASSERT_EQ(runCommand(bin + " clone --reconstruction " + dir + "/rec.yml --masks " + dir +
+                             "/odd --out " + dir + "/odd.yml.gz", &out), 0) << out;
+        EXPECT_NE(out.find(cv::format("object 'tower', key frame %d:", kf)), std::string::npos)
+            << out;
+        EXPECT_EQ(out.find("object 'ell', key frame"), std::string::npos) << out;
+        Ptr<CloneSet> c6 = CloneSet::load(dir + "/odd.yml.gz");
+        Mat matte;
+        c6->render("tower", kf, s.rec.cameras[kf], s.rec.imageSize, matte);
+        EXPECT_GE(maskIoU(matte, m), kKeyFrameMinIoU);
+    }
     // --tracks: the points' observations (exact projections here); free space on by default,
     // --no-free-space keeps the silhouettes-only clone; tracks that do not match the points: 2.
     {
