@@ -231,6 +231,32 @@ TEST(Augocc_Pipeline, accuracy_demo)
     fs::remove_all(o.outDir);
 }
 
+// The same from strongly perspective footage (`augocc demo --model perspective --distance-ratio
+// 3`: the camera three scene sizes away, as hand-held footage near the buildings). Measured
+// 2026-12-01: 99.86% within 8 grey levels, rotation error 0.109 deg, focal length 0.6% off;
+// occlusion boundary 2.52 px over the 51 frames with one (3-4 px in frames 0-30, where a thin
+// sliver of the L-block's clone stays in front of the dome's lower left; under 1 px after frame
+// 38). The issue's 1.5 px is for the default demo; here a regression bound above the measurement.
+const double kPerspectiveDemoMaxBoundaryPx = 3.5;
+
+TEST(Augocc_Pipeline, accuracy_demo_perspective)
+{
+    DemoOptions o;
+    o.model = PERSPECTIVE;
+    o.distanceRatio = 3;
+    o.outDir = (fs::temp_directory_path() / cv::format("augocc_demo_p_test_%d", (int)getpid()))
+                   .string();
+    const DemoResult r = runDemo(o);
+    std::cout << "perspective demo: " << 100 * r.fractionWithin << "% within 8 grey levels, "
+              << "occlusion boundary " << r.boundaryDistance << " px, rotation error "
+              << r.rotationErrorDeg << " deg, model " << r.run.reconstruction.model << std::endl;
+    EXPECT_EQ(r.run.reconstruction.model, PERSPECTIVE);
+    EXPECT_GE(r.fractionWithin, kDemoMinWithin);
+    EXPECT_LE(r.boundaryDistance, kPerspectiveDemoMaxBoundaryPx);
+    EXPECT_LE(r.rotationErrorDeg, kDemoMaxRotationDeg);
+    fs::remove_all(o.outDir);
+}
+
 // Issue 5, edge quality: band error (2 px around the occlusion boundary) against the 4x
 // supersampled truth, soft edges (default compositor, k = 3) against the hard depth test, with
 // the real objects' exact geometry as occluders (MeshClones), so that the figure is the

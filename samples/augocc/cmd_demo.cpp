@@ -18,13 +18,25 @@ void registerDemo(CLI::App& app, Globals& g)
 {
     auto outDir = std::make_shared<std::string>("augocc_demo");
     auto noPhoto = std::make_shared<bool>(false);
+    auto model = std::make_shared<std::string>("scaled_orthographic");
+    auto distance = std::make_shared<double>(DemoOptions().distanceRatio);
     CLI::App* sub = app.add_subcommand("demo", "synthesize a scene and run the whole pipeline "
                                        "on it (no input needed)");
     sub->add_option("--out-dir", *outDir, "output folder (default augocc_demo)");
     sub->add_flag("--no-photo-refine", *noPhoto, "clones from the silhouettes alone (no "
                   "photo-consistency carving over the frames)");
-    sub->callback([&g, outDir, noPhoto]() {
+    sub->add_option("--model", *model, "camera of the synthesized footage: scaled_orthographic "
+                    "(default) or perspective");
+    sub->add_option("--distance-ratio", *distance, "camera distance over the scene size (default "
+                    "10; 3 is hand-held footage near the buildings, strong perspective)");
+    sub->callback([&g, outDir, noPhoto, model, distance]() {
         DemoOptions o;
+        if (*model != "scaled_orthographic" && *model != "perspective")
+            throw UsageError("--model " + *model + ": expected scaled_orthographic or perspective");
+        if (!(*distance >= 1.0))
+            throw UsageError(cv::format("--distance-ratio %g: must be >= 1", *distance));
+        o.model = *model == "perspective" ? PERSPECTIVE : SCALED_ORTHOGRAPHIC;
+        o.distanceRatio = *distance;
         o.outDir = *outDir;
         o.photoRefine = !*noPhoto;
         std::shared_ptr<Progress> current;

@@ -648,6 +648,8 @@ DemoResult runDemo(const DemoOptions& o)
     SceneSynthesizer::Params sp;
     sp.frames = o.frames;
     sp.imageSize = o.imageSize;
+    sp.model = o.model;
+    sp.distanceRatio = o.distanceRatio;
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
     SyntheticScene scene;
     if (o.progress)

@@ -147,6 +147,11 @@ struct CV_EXPORTS DemoOptions
     String outDir = "augocc_demo";
     int frames = 60;
     Size imageSize = Size(640, 480);
+    //! Camera model of the synthesized footage (SceneSynthesizer::Params::model).
+    CameraModel model = SCALED_ORTHOGRAPHIC;
+    //! Camera distance over the scene size (SceneSynthesizer::Params::distanceRatio; small values
+    //! give strong perspective, as hand-held footage near a building).
+    double distanceRatio = 10.0;
     bool photoRefine = true;  //!< RunOptions::photoRefine
     std::function<void(const String& stage, int done, int total)> progress;
 };
