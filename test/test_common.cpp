@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "test_precomp.hpp"
+#include <opencv2/calib3d.hpp>
 
 #include <array>
 #include <cstdio>
@@ -87,6 +88,37 @@ double maskIoU(const cv::Mat& a, const cv::Mat& b)
     const double inter = cv::countNonZero(ia & ib);
     const double uni = cv::countNonZero(ia | ib);
     return uni > 0 ? inter / uni : 1.0;
+}
+
+void decomposeKR(const cv::Matx33d& M, cv::Matx33d& K, cv::Matx33d& R)
+{
+    cv::RQDecomp3x3(M, K, R);
+    for (int d = 0; d < 3; d++)
+        if (K(d, d) < 0)
+        {
+            for (int r = 0; r < 3; r++)
+                K(r, d) = -K(r, d);
+            for (int c = 0; c < 3; c++)
+                R(d, c) = -R(d, c);
+        }
+}
+
+cv::augocc::Camera cameraFromProjection(const cv::Matx34d& P0, int frame)
+{
+    cv::Matx34d P = P0;
+    cv::Matx33d M = P.get_minor<3, 3>(0, 0);
+    if (cv::determinant(M) < 0)
+    {
+        // P and -P are the same camera; with K's diagonal positive, det R = sign(det M).
+        P = P * -1.0;
+        M = M * -1.0;
+    }
+    cv::Matx33d K, R;
+    decomposeKR(M, K, R);
+    const cv::Vec3d t = K.inv() * cv::Vec3d(P(0, 3), P(1, 3), P(2, 3));
+    K *= 1.0 / K(2, 2);
+    K(1, 0) = K(2, 0) = K(2, 1) = 0;  // RQ's round-off below the diagonal
+    return cv::augocc::Camera::perspective(R, t, K, frame);
 }
 
 } // namespace opencv_test

@@ -7,6 +7,7 @@
 #include <string>
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
+#include "opencv2/augocc/camera.hpp"
 
 namespace opencv_test {
 
@@ -35,6 +36,12 @@ int runCommand(const std::string& cmd, std::string* output = nullptr);
 
 //! Intersection over union of two binary masks (> 0 = in).
 double maskIoU(const cv::Mat& a, const cv::Mat& b);
+
+//! M = K R by RQ decomposition, K's diagonal made positive (the signs moved into R's rows).
+void decomposeKR(const cv::Matx33d& M, cv::Matx33d& K, cv::Matx33d& R);
+//! A 3x4 projection matrix (P maps X to (col, row, w), up to scale and sign) as a perspective
+//! Camera: K upper triangular with a positive diagonal and K(2,2) = 1, det R = +1.
+cv::augocc::Camera cameraFromProjection(const cv::Matx34d& P, int frame);
 
 } // namespace opencv_test
 

@@ -147,20 +147,6 @@ TEST(Augocc_SfmRealData, cmu_hotel_frames_track_sfm_landmarks)
     EXPECT_LE(median, kHotelLandmarkMedianPx);
 }
 
-// M = K R by RQ decomposition with K's diagonal positive (the sign moved into R's rows).
-void decomposeKR(const Matx33d& M, Matx33d& K, Matx33d& R)
-{
-    RQDecomp3x3(M, K, R);
-    for (int d = 0; d < 3; d++)
-        if (K(d, d) < 0)
-        {
-            for (int r = 0; r < 3; r++)
-                K(r, d) = -K(r, d);
-            for (int c = 0; c < 3; c++)
-                R(d, c) = -R(d, c);
-        }
-}
-
 // Reads dino_Ps.txt: 36 blocks of 3 lines; P maps X to (row, col, w). Rows 0 and 1 are
 // swapped to get the contract's (x = col, y = row), then P is decomposed to K [R | t].
 bool readDinoCameras(const std::string& path, Reconstruction& gt)
@@ -190,19 +176,7 @@ bool readDinoCameras(const std::string& path, Reconstruction& gt)
             P.val[k] = vals[i * 12 + k];
         for (int c = 0; c < 4; c++)
             std::swap(P(0, c), P(1, c));
-        Matx33d M = P.get_minor<3, 3>(0, 0);
-        if (determinant(M) < 0)
-        {
-            P = P * -1.0;
-            M = M * -1.0;
-        }
-        Matx33d K, R;
-        decomposeKR(M, K, R);
-        const double k22 = K(2, 2);
-        const Vec3d t = K.inv() * Vec3d(P(0, 3), P(1, 3), P(2, 3));
-        K *= 1.0 / k22;
-        K(1, 0) = K(2, 0) = K(2, 1) = 0;
-        gt.cameras.push_back(Camera::perspective(R, t, K, i));
+        gt.cameras.push_back(cameraFromProjection(P, i));
     }
     return true;
 }
