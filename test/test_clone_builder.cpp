@@ -306,6 +306,9 @@ TEST(Augocc_CloneBuilder, bad_arg)
     p = CloneBuilder::Params();
     p.freeSpaceEdgeMargin = std::numeric_limits<double>::quiet_NaN();
     EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
+    p = CloneBuilder::Params();
+    p.freeSpacePlanarDeg = 91;
+    EXPECT_THROW(CloneBuilder::create(p), cv::Exception);
 
     AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, towerAndEll(), 12, 3);
     Ptr<CloneBuilder> b = CloneBuilder::create();
@@ -883,12 +886,13 @@ SynthFigures measureSynth(const CloneSet& clones, const SyntheticScene& s, const
 // Objects of the synthesized scene hidden by more than this fraction in the key frames on average
 // count as "hidden" for the occlusion target (mean IoU 0.97 instead of 0.98).
 const double kHiddenObjectFraction = 0.02;
-// Hidden objects, mean IoU with the WHOLE true silhouette (as if alone) in non-key frames: the issue
-// asks 0.97; measured since voxels no key frame shows are dropped: lblock 0.972 / 0.979, tower
-// 0.959 / 0.959 (orthographic / perspective; 0.914 / 0.846 before), with free-space carving
-// (2026-12-01) tower 0.964 / 0.967: what is left is behind the building in every key frame and
-// behind the tower itself in the other views. A regression bound under the worst, not the target.
-const double kHiddenWholeMeanIoU = 0.95;
+// Hidden objects, mean IoU with the WHOLE true silhouette (as if alone) in non-key frames: the
+// issue's 0.97. History (orthographic / perspective): voxels no key frame shows dropped: lblock
+// 0.972 / 0.979, tower 0.959 / 0.959 (0.914 / 0.846 before); free-space carving: tower 0.964 /
+// 0.967 (the rest is behind the building in every frame and behind the tower's own shaft in the
+// others); vertical runs no frame sees dropped (2026-12-01): tower 0.971 / 0.981, lblock
+// 0.972 / 0.980.
+const double kHiddenWholeMeanIoU = kHiddenMeanIoU;
 
 typedef testing::TestWithParam<int> Augocc_CloneBuilder_Synth;
 
@@ -942,6 +946,37 @@ TEST_P(Augocc_CloneBuilder_Synth, accuracy_gt_cameras)
 
 INSTANTIATE_TEST_SUITE_P(/**/, Augocc_CloneBuilder_Synth,
                          testing::Values((int)SCALED_ORTHOGRAPHIC, (int)PERSPECTIVE));
+
+// Vertical runs of voxels that no frame sees (dropUnobserved): on the synthesized scene the
+// tower's lower shaft is behind the building in the first key frames and behind its own front in
+// the last, so the visual hull keeps a wedge behind it that shows in its matte as if alone. Measured
+// 2026-12-01 (orthographic), tower's non-key mean IoU with its whole silhouette 0.9641 -> 0.9711
+// (worst frame 0.913 -> 0.940), recall 0.99698 -> 0.99688; building and L-block within 0.0005.
+// Bounds: the tower gains at least 0.005; no object's recall loses more than 0.001, nor its IoU.
+TEST(Augocc_CloneBuilder_Unobserved, synth_tower)
+{
+    SyntheticScene s;
+    SceneSynthesizer::create()->synthesize(s);
+    CloneBuilder::Params keep;
+    keep.dropUnobserved = false;
+    Ptr<CloneSet> a = CloneBuilder::create(keep)->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+    Ptr<CloneSet> b = CloneBuilder::create()->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+    for (const String& name : b->objectNames())
+    {
+        const SynthFigures fa = measureSynth(*a, s, name), fb = measureSynth(*b, s, name);
+        std::cout << name << ": non-key mean IoU " << fa.nonKeyMean << " -> " << fb.nonKeyMean
+                  << ", worst " << fa.nonKeyMin << " -> " << fb.nonKeyMin << ", recall "
+                  << fa.recall << " -> " << fb.recall << ", voxels " << a->voxelCount(name)
+                  << " -> " << b->voxelCount(name) << std::endl;
+        EXPECT_GE(fb.keyMin, kKeyFrameMinIoU) << name;
+        EXPECT_GE(fb.recall, fa.recall - 0.001) << name;
+        EXPECT_GE(fb.nonKeyMean, fa.nonKeyMean - 0.001) << name;
+        if (name == "tower")
+        {
+            EXPECT_GE(fb.nonKeyMean, fa.nonKeyMean + 0.005);
+        }
+    }
+}
 
 
 } // namespace
@@ -1124,13 +1159,21 @@ TEST(Augocc_CloneBuilder_Photo, accuracy_synth)
 // Free-space carving from the tracks (build() with tracks) on the synthesized scene, GT cameras,
 // both camera models: depth of the clones against the truth without and with it, and the
 // silhouette figures, which it must not spoil. Measured 2026-12-01 (orthographic / perspective),
-// mean |dz| in voxels, silhouettes only -> with free space:
-//   building 6.97 -> 6.56 / 8.71 -> 7.79, recall 0.99941 -> 0.99930 / 0.99910 -> 0.99846
-//   lblock  42.4 -> 12.7 / 49.0 -> 13.1 (the inner corner's phantom), non-key IoU +0.0002 / +0.0005
-//   tower   14.4 -> 8.5 / 15.2 -> 9.3, non-key IoU 0.9592 -> 0.9641 / 0.9587 -> 0.9672
+// mean |dz| in voxels, silhouettes only -> free space with every triangle flat at its nearest
+// corner (freeSpacePlanarDeg 0) -> planar triangles following their plane (default):
+//   building 6.97 -> 6.56 -> 4.40 / 8.71 -> 7.79 -> 5.02, recall 0.99941 -> 0.99927 / 0.99910 ->
+//            0.99847
+//   lblock  42.4 -> 12.7 -> 7.93 / 49.0 -> 13.1 -> 8.04 (the inner corner's phantom), non-key IoU
+//           +0.0002 / +0.0004
+//   tower   14.4 -> 8.5 -> 4.07 / 15.2 -> 9.3 -> 4.11, non-key IoU 0.9592 -> 0.9644 / 0.9602 ->
+//           0.9691
+// Pixels more than 3 voxels in front of the true surface: building 93% -> 49%, L-block 96% ->
+// 51%, tower 76% -> 36% (orthographic).
 // Bounds: recall and IoU may lose at most 0.001 (measured worst 0.00064, perspective building:
 // corners that triangles span); every object's depth error must drop by 2% at least, the
-// L-block's by half (measured 0.30 / 0.27).
+// L-block's by half (measured 0.19 / 0.16); the planar triangles must take a fifth more off
+// every object's depth error than the flat ones (measured 0.46 - 0.67).
+const double kFreeSpacePlanarDepthRatio = 0.8;
 typedef testing::TestWithParam<int> Augocc_CloneBuilder_FreeSpace_P;
 
 TEST_P(Augocc_CloneBuilder_FreeSpace_P, accuracy_synth)
@@ -1143,12 +1186,20 @@ TEST_P(Augocc_CloneBuilder_FreeSpace_P, accuracy_synth)
     off.freeSpaceMinViews = 0;
     Ptr<CloneSet> hull = CloneBuilder::create(off)->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
     Ptr<CloneSet> clones = CloneBuilder::create()->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+    CloneBuilder::Params flat;
+    flat.freeSpacePlanarDeg = 0;
+    Ptr<CloneSet> flatClones =
+        CloneBuilder::create(flat)->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
     for (const String& name : clones->objectNames())
     {
         const SynthFigures f0 = measureSynth(*hull, s, name), f = measureSynth(*clones, s, name);
         const DepthFigures d0 = measureDepth(*hull, s, name), d = measureDepth(*clones, s, name);
+        const DepthFigures dflat = measureDepth(*flatClones, s, name);
         printPhoto((cameraModelName(sp.model) + " silhouettes").c_str(), name, f0, d0);
+        printPhoto((cameraModelName(sp.model) + " flat free  ").c_str(), name,
+                   measureSynth(*flatClones, s, name), dflat);
         printPhoto((cameraModelName(sp.model) + " free space ").c_str(), name, f, d);
+        EXPECT_LE(d.meanAbs, kFreeSpacePlanarDepthRatio * dflat.meanAbs) << name;
         EXPECT_GE(f.keyMin, kKeyFrameMinIoU) << name;
         EXPECT_GE(f.recall, f0.recall - kFreeSpaceMaxRecallLoss) << name;
         EXPECT_GE(f.nonKeyMean, f0.nonKeyMean - kFreeSpaceMaxIoULoss) << name;

@@ -5,8 +5,10 @@
 
 #include "precomp.hpp"
 #include "clone_internal.hpp"
+#include "key_frame_coverage.hpp"
 
 #include <climits>
+#include <set>
 
 namespace cv {
 namespace augocc {
@@ -16,7 +18,8 @@ CloneBuilder::Params::Params()
       orientation(ORIENT_AUTO), userRotation(0, 0, 0), raysPerPixel(2), patchRule(PATCH_NEAREST),
       occlusionAware(true), trimFraction(0.02), minPoints(4), photoThreshold(15),
       photoMinAgreement(0.95), photoMinViews(4), photoRounds(1), photoPatchStep(0),
-      photoMaxViews(24), freeSpaceMinViews(2), freeSpaceEdgeMargin(0.5)
+      photoMaxViews(24), freeSpaceMinViews(2), freeSpaceEdgeMargin(0.5), freeSpacePlanarDeg(30),
+      dropUnobserved(true)
 {
 }
 
@@ -600,6 +603,8 @@ public:
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::freeSpaceMinViews must be >= 0");
         if (!(p.freeSpaceEdgeMargin >= 0) || !std::isfinite(p.freeSpaceEdgeMargin))
             CV_Error(Error::StsBadArg, "CloneBuilder::Params::freeSpaceEdgeMargin must be >= 0");
+        if (!(p.freeSpacePlanarDeg >= 0 && p.freeSpacePlanarDeg <= 90))
+            CV_Error(Error::StsBadArg, "CloneBuilder::Params::freeSpacePlanarDeg must be in [0, 90]");
         params_ = p;
     }
 
@@ -967,6 +972,169 @@ void keepOutsideBoxNear(ObjectClone& obj, const Box& box, const std::vector<Vec3
     obj.surface = g.surface();
 }
 
+// Beyond the paper, for what no frame can see. A part of the visual hull that is behind another
+// object or behind the object's own near side in every frame of the video (the lower back of a
+// tower behind a building in the first key frames and behind its own shaft in the last) is not
+// constrained by any silhouette: the hull keeps it at its largest, a wedge along the lines of
+// sight of the key frames that see the part. Since no frame sees it, it changes no composite of
+// the video; but it is conjecture, and in the object's matte as if alone (and in any view beyond
+// the video) it shows as a bulge. The prior taken here is support along the vertical: the clone's
+// voxels are cut into vertical runs (the grid axis nearest the vertical the cameras give), and a
+// run none of whose voxels any frame shows (first along its line of sight among every clone's
+// voxels, in kObservableViews evenly spaced frames and every key frame) goes. The inside of a
+// building under its seen roof, the hidden back of a shaft under its seen cap, stay (their run
+// holds a seen voxel); a wedge with air above it and the ground below goes. Returns the number of
+// voxels removed per object.
+const int kObservableViews = 30;
+// A surface voxel is seen when its centre is within this many voxel edges of the nearest clone
+// depth at its pixel.
+const double kObservableTolVoxels = 1.5;
+// The vertical must be within this angle of a grid axis for the runs to follow it (degrees).
+const double kMaxRunTiltDeg = 20;
+
+std::map<String, int64> dropUnobservedRuns(std::map<String, ObjectClone>& objs,
+                                           const Reconstruction& rec)
+{
+    std::map<String, int64> removed;
+    std::vector<const Camera*> cams = evenlySpacedCameras(rec, kObservableViews);
+    std::set<int> have;
+    for (const Camera* c : cams)
+        have.insert(c->frame);
+    for (const auto& o : objs)
+        for (const auto& m : o.second.masks)
+            if (!have.count(m.first))
+            {
+                have.insert(m.first);
+                cams.push_back(&rec.camera(m.first));
+            }
+    std::vector<String> names;
+    for (const auto& o : objs)
+        names.push_back(o.first);
+    // Per frame and object, the surface voxels seen (frames in parallel, merged in order).
+    std::vector<std::vector<std::vector<uint32_t> > > seenIn(
+        cams.size(), std::vector<std::vector<uint32_t> >(names.size()));
+    const Size size = rec.imageSize;
+    parallel_for_(Range(0, (int)cams.size()), [&](const Range& r) {
+        for (int ci = r.start; ci < r.end; ci++)
+        {
+            const Camera& cam = *cams[ci];
+            Mat zbuf(size, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+            std::vector<VoxelProjector> projs(names.size());
+            for (size_t n = 0; n < names.size(); n++)
+            {
+                const ObjectClone& obj = objs.at(names[n]);
+                if (obj.grid.empty())
+                    continue;
+                projs[n] = obj.grid.projector(cam, size);
+                splatVoxels(projs[n], obj.surface.ijk.data(), obj.surface.faces.data(),
+                            obj.surface.size(), true, zbuf, nullptr, Point());
+            }
+            for (size_t n = 0; n < names.size(); n++)
+            {
+                const ObjectClone& obj = objs.at(names[n]);
+                if (obj.grid.empty())
+                    continue;
+                const double tol = kObservableTolVoxels * obj.grid.h;
+                for (size_t q = 0; q < obj.surface.size(); q++)
+                {
+                    int i, j, k;
+                    unpackVoxel(obj.surface.ijk[q], i, j, k);
+                    Point px;
+                    if (!projs[n].centrePixel(i, j, k, px) || px.x < 0 || px.y < 0 ||
+                        px.x >= size.width || px.y >= size.height)
+                        continue;
+                    const double z = projs[n].Z.dot(Vec3d(i, j, k)) + projs[n].z0;
+                    if (z <= zbuf.at<float>(px) + tol)
+                        seenIn[ci][n].push_back((uint32_t)q);
+                }
+            }
+        }
+    });
+    std::map<String, std::vector<uchar> > seen;
+    for (size_t n = 0; n < names.size(); n++)
+    {
+        const ObjectClone& obj = objs.at(names[n]);
+        std::vector<uchar>& sn = seen[names[n]];
+        sn.assign(obj.grid.data.size(), 0);
+        for (size_t ci = 0; ci < cams.size(); ci++)
+            for (uint32_t q : seenIn[ci][n])
+            {
+                int i, j, k;
+                unpackVoxel(obj.surface.ijk[q], i, j, k);
+                sn[obj.grid.index(i, j, k)] = 1;
+            }
+    }
+    const Vec3d up = estimateVertical(rec);
+    for (auto& o : objs)
+    {
+        VoxelGrid& g = o.second.grid;
+        removed[o.first] = 0;
+        if (g.empty())
+            continue;
+        int axis = 0;
+        double best = 0;
+        for (int a = 0; a < 3; a++)
+        {
+            const double c = std::abs(up.dot(Vec3d(g.Rbox(0, a), g.Rbox(1, a), g.Rbox(2, a))));
+            if (c > best)
+            {
+                best = c;
+                axis = a;
+            }
+        }
+        if (best < std::cos(kMaxRunTiltDeg * CV_PI / 180))
+            continue;
+        const std::vector<uchar>& sn = seen[o.first];
+        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+        std::vector<int64> perSlice(g.dims[v], 0);
+        parallel_for_(Range(0, g.dims[v]), [&](const Range& r) {
+            for (int b = r.start; b < r.end; b++)
+                for (int a = 0; a < g.dims[u]; a++)
+                {
+                    int idx[3];
+                    idx[u] = a;
+                    idx[v] = b;
+                    int start = -1;
+                    bool any = false;
+                    for (int t = 0; t <= g.dims[axis]; t++)
+                    {
+                        bool in = false;
+                        size_t id = 0;
+                        if (t < g.dims[axis])
+                        {
+                            idx[axis] = t;
+                            id = g.index(idx[0], idx[1], idx[2]);
+                            in = g.data[id] != 0;
+                        }
+                        if (in)
+                        {
+                            if (start < 0)
+                            {
+                                start = t;
+                                any = false;
+                            }
+                            any = any || sn[id];
+                            continue;
+                        }
+                        if (start >= 0 && !any)
+                            for (int w = start; w < t; w++)
+                            {
+                                idx[axis] = w;
+                                g.data[g.index(idx[0], idx[1], idx[2])] = 0;
+                                perSlice[b]++;
+                            }
+                        start = -1;
+                    }
+                }
+        });
+        for (int64 n : perSlice)
+            removed[o.first] += n;
+        if (removed[o.first] > 0)
+            o.second.surface = g.surface();
+    }
+    return removed;
+}
+
 // Step 5 for every key frame (the clone changed, so every patch set is redone).
 void recomputePatches(std::map<String, ObjectClone>& objs, ObjectClone& obj,
                       const Reconstruction& rec, bool occlusionAware, int raysPerPixel)
@@ -1085,6 +1253,7 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
         FreeSpaceParams fp;
         fp.minViews = params_.freeSpaceMinViews;
         fp.edgeMargin = params_.freeSpaceEdgeMargin;
+        fp.planarDeg = params_.freeSpacePlanarDeg;
         for (const auto& c : freeSpaceCarve(*set, rec, *tracks, members, fp))
         {
             CV_UNUSED(c);  // with the debug log compiled out
@@ -1092,6 +1261,14 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
                          c.first.c_str(), (long long)c.second));
         }
     }
+    // Beyond the paper: what no frame sees.
+    if (params_.dropUnobserved)
+        for (const auto& c : dropUnobservedRuns(set->objects, rec))
+        {
+            CV_UNUSED(c);  // with the debug log compiled out
+            CV_LOG_DEBUG(NULL, cv::format("augocc: object '%s': %lld voxels in vertical runs no "
+                         "frame sees removed", c.first.c_str(), (long long)c.second));
+        }
     // Step 5 per object.
     for (auto& o : set->objects)
         recomputePatches(set->objects, o.second, rec, params_.occlusionAware,

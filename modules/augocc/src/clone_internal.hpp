@@ -85,10 +85,14 @@ struct FreeSpaceParams
                                // (span gaps) are not used
     double maxReprojPx = 2;    // observations farther than this from their point are not used
     int maxViews = 30;         // frames used, evenly spaced (0: all)
+    double planarDeg = 0;      // triangles on one plane with their three neighbours (normals
+                               // within this angle, degrees) follow their plane (0: every
+                               // triangle is flat at its nearest vertex)
 };
 
 /** @brief Free-space carving from the tracks: in every frame, the triangles (Delaunay, in the
-image) of the object's points seen there are empty in front of their nearest vertex by a margin;
+image) of the object's points seen there are empty in front of their nearest vertex by a margin
+(planar ones, on one facade with their neighbours, in front of their plane by marginVoxels);
 voxels shown free by at least params.minViews frames go, peeled from the surface, never one that
 a key-frame silhouette pixel needs. `members` lists each object's points (Step 1). Updates the
 grids and surfaces (not the patches). Returns the voxels carved per object. */

@@ -9,7 +9,8 @@
 // scene), so, as those methods do with their triangulations, the free space is spread over the
 // Delaunay triangles of an object's points in the image: a triangle is taken as empty in front
 // of its nearest corner, less a margin that grows with its size (a triangle that spans a convex
-// corner passes in front of the corner). The visual hull from a narrow orbit is deep along the
+// corner passes in front of the corner); a triangle on one plane with its three neighbours (a
+// facade) in front of its own plane, less a margin of a few voxels. The visual hull from a narrow orbit is deep along the
 // lines of sight (a box seen over 50 degrees keeps a wedge in front of its facade) and fills
 // concavities (an L-shaped block's inner corner); these phantoms hide virtual objects that
 // stand in front of the real ones, and free space removes them where the object has texture.
@@ -37,6 +38,7 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
     const Rect img(0, 0, size.width, size.height);
     std::vector<Point2f> px;
     std::vector<double> z;
+    std::vector<Vec3d> Xs;
     const double r2 = params.maxReprojPx * params.maxReprojPx;
     for (int p : pts)
     {
@@ -53,83 +55,174 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
             continue;
         px.push_back(o);
         z.push_back(d);
+        Xs.push_back(Xw);
     }
     if (px.size() < 3)
         return Mat();
     Subdiv2D sub(Rect(-1, -1, size.width + 2, size.height + 2));
-    // Vertex position -> depth (the nearest of coincident points).
-    std::map<std::pair<float, float>, double> depthOf;
+    // Vertex position -> its point (the nearest of coincident points).
+    std::map<std::pair<float, float>, int> vertexOf;
     for (size_t q = 0; q < px.size(); q++)
     {
         const std::pair<float, float> key(px[q].x, px[q].y);
-        auto it = depthOf.find(key);
-        if (it == depthOf.end())
+        auto it = vertexOf.find(key);
+        if (it == vertexOf.end())
         {
             sub.insert(px[q]);
-            depthOf[key] = z[q];
+            vertexOf[key] = (int)q;
         }
-        else
-            it->second = std::min(it->second, z[q]);
+        else if (z[q] < z[it->second])
+            it->second = (int)q;
     }
     std::vector<Vec6f> tris;
     sub.getTriangleList(tris);
     struct Tri
     {
-        Point v[3];
-        float value;
+        int v[3];
+        double edge = 0, zmin = 0;
+        Vec3d normal;
+        bool planar = false;
     };
     std::vector<Tri> keep;
-    std::vector<double> edges, depths;
     for (const Vec6f& t : tris)
     {
         Tri tri;
-        double zmin = std::numeric_limits<double>::infinity(), edge = 0;
+        tri.zmin = std::numeric_limits<double>::infinity();
         bool ok = true;
         for (int c = 0; c < 3 && ok; c++)
         {
             const Point2f a(t[2 * c], t[2 * c + 1]), b(t[(2 * c + 2) % 6], t[(2 * c + 3) % 6]);
-            edge = std::max(edge, (double)cv::norm(a - b));
-            auto it = depthOf.find(std::pair<float, float>(a.x, a.y));
-            ok = it != depthOf.end();
+            tri.edge = std::max(tri.edge, (double)cv::norm(a - b));
+            auto it = vertexOf.find(std::pair<float, float>(a.x, a.y));
+            ok = it != vertexOf.end();
             if (ok)
-                zmin = std::min(zmin, it->second);
-            tri.v[c] = Point(cvRound(a.x * 16), cvRound(a.y * 16));
+            {
+                tri.v[c] = it->second;
+                tri.zmin = std::min(tri.zmin, z[it->second]);
+            }
         }
         if (!ok)
             continue;
+        const Vec3d n = (Xs[tri.v[1]] - Xs[tri.v[0]]).cross(Xs[tri.v[2]] - Xs[tri.v[0]]);
+        const double nn = cv::norm(n);
+        tri.normal = nn > 0 ? n / nn : Vec3d(0, 0, 0);
         keep.push_back(tri);
-        edges.push_back(edge);
-        depths.push_back(zmin);
     }
     if (keep.empty())
         return Mat();
+    // A triangle is planar when it and the three triangles across its edges lie on one plane
+    // (normals within params.planarDeg): on a facade, not spanning a corner. Its free space
+    // follows its plane (depth interpolated over the triangle, 1/z under perspective) less
+    // marginVoxels; the others stay flat at their nearest vertex less the edge margin (a triangle
+    // that spans a convex corner passes in front of the corner by up to about half its edge).
+    std::map<std::pair<int, int>, std::vector<int> > byEdge;
+    for (size_t q = 0; q < keep.size(); q++)
+        for (int c = 0; c < 3; c++)
+        {
+            const int a = keep[q].v[c], b = keep[q].v[(c + 1) % 3];
+            byEdge[std::make_pair(std::min(a, b), std::max(a, b))].push_back((int)q);
+        }
+    const double cosPlanar = std::cos(params.planarDeg * CV_PI / 180);
+    for (size_t q = 0; q < keep.size(); q++)
+    {
+        Tri& t = keep[q];
+        if (params.planarDeg <= 0 || cv::norm(t.normal) == 0)
+            continue;
+        int across = 0;
+        bool planar = true;
+        for (int c = 0; c < 3 && planar; c++)
+        {
+            const int a = t.v[c], b = t.v[(c + 1) % 3];
+            for (int o : byEdge[std::make_pair(std::min(a, b), std::max(a, b))])
+                if (o != (int)q)
+                {
+                    across++;
+                    planar = std::abs(keep[o].normal.dot(t.normal)) >= cosPlanar;
+                }
+        }
+        t.planar = planar && across == 3;
+    }
     // Triangles much longer than is typical for this frame's points span gaps (between two parts
-    // of the object, across a notch): they are left out. Relative, so that the rule does not
-    // depend on the image size or on how many tracks the tracker keeps.
-    std::vector<double> sorted = edges;
+    // of the object, across a notch): they are left out unless planar (on one facade with their
+    // neighbours: the gap is then the facade itself, sparse in tracks). Relative, so that the
+    // rule does not depend on the image size or on how many tracks the tracker keeps.
+    std::vector<double> sorted;
+    for (const Tri& t : keep)
+        sorted.push_back(t.edge);
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     const double maxEdge = params.maxEdgeRatio * sorted[sorted.size() / 2];
     size_t w = 0;
     for (size_t q = 0; q < keep.size(); q++)
-    {
-        if (edges[q] > maxEdge)
-            continue;
-        const double ppu = cam.pixelsPerUnit(depths[q]);
-        const double margin =
-            std::max(params.marginVoxels * h, params.edgeMargin * edges[q] / ppu);
-        keep[w] = keep[q];
-        keep[w].value = (float)(depths[q] - margin);
-        w++;
-    }
+        if (keep[q].edge <= maxEdge || keep[q].planar)
+            keep[w++] = keep[q];
     keep.resize(w);
     if (keep.empty())
         return Mat();
-    // Nearer values last: a pixel shared by two triangles keeps the nearer (conservative).
-    std::stable_sort(keep.begin(), keep.end(),
-                     [](const Tri& a, const Tri& b) { return a.value > b.value; });
-    Mat free(size, CV_32F, Scalar(-std::numeric_limits<float>::infinity()));
+    // Flat triangles first, nearer values last (a pixel shared by two keeps the nearer:
+    // conservative); then the planar ones, each pixel keeping the nearer of what it has.
+    struct Flat
+    {
+        Point v[3];
+        float value;
+    };
+    std::vector<Flat> flats;
     for (const Tri& t : keep)
-        fillConvexPoly(free, t.v, 3, Scalar(t.value), LINE_8, 4);
+        if (!t.planar)
+        {
+            const double ppu = cam.pixelsPerUnit(t.zmin);
+            const double margin =
+                std::max(params.marginVoxels * h, params.edgeMargin * t.edge / ppu);
+            Flat fl;
+            for (int c = 0; c < 3; c++)
+                fl.v[c] = Point(cvRound(px[t.v[c]].x * 16), cvRound(px[t.v[c]].y * 16));
+            fl.value = (float)(t.zmin - margin);
+            flats.push_back(fl);
+        }
+    std::stable_sort(flats.begin(), flats.end(),
+                     [](const Flat& u, const Flat& v) { return u.value > v.value; });
+    Mat free(size, CV_32F, Scalar(-std::numeric_limits<float>::infinity()));
+    for (const Flat& fl : flats)
+        fillConvexPoly(free, fl.v, 3, Scalar(fl.value), LINE_8, 4);
+    const bool persp = cam.model == PERSPECTIVE;
+    const float none = -std::numeric_limits<float>::infinity();
+    for (const Tri& t : keep)
+    {
+        if (!t.planar)
+            continue;
+        const double margin = params.marginVoxels * h;
+        const Point2d A(px[t.v[0]]), B(px[t.v[1]]), C(px[t.v[2]]);
+        const double det = (B.x - A.x) * (C.y - A.y) - (C.x - A.x) * (B.y - A.y);
+        if (std::abs(det) < 1e-9)
+            continue;
+        double q0 = z[t.v[0]], q1 = z[t.v[1]], q2 = z[t.v[2]];
+        if (persp)
+        {
+            q0 = 1 / q0;
+            q1 = 1 / q1;
+            q2 = 1 / q2;
+        }
+        const int x0 = std::max(0, cvFloor(std::min(A.x, std::min(B.x, C.x))));
+        const int x1 = std::min(size.width - 1, cvCeil(std::max(A.x, std::max(B.x, C.x))));
+        const int y0 = std::max(0, cvFloor(std::min(A.y, std::min(B.y, C.y))));
+        const int y1 = std::min(size.height - 1, cvCeil(std::max(A.y, std::max(B.y, C.y))));
+        for (int y = y0; y <= y1; y++)
+        {
+            float* row = free.ptr<float>(y);
+            for (int x = x0; x <= x1; x++)
+            {
+                const double l1 = ((x - A.x) * (C.y - A.y) - (C.x - A.x) * (y - A.y)) / det;
+                const double l2 = ((B.x - A.x) * (y - A.y) - (x - A.x) * (B.y - A.y)) / det;
+                const double l0 = 1 - l1 - l2;
+                if (l0 < 0 || l1 < 0 || l2 < 0)
+                    continue;
+                double zi = l0 * q0 + l1 * q1 + l2 * q2;
+                if (persp)
+                    zi = 1 / zi;
+                const float value = (float)(zi - margin);
+                row[x] = row[x] == none ? value : std::min(row[x], value);
+            }
+        }
+    }
     return free;
 }
 

@@ -167,6 +167,21 @@ public:
         a triangle spanning a convex corner passes in front of the corner by up to about half its
         edge, which the margin keeps. Lower carves closer to flat facades. */
         double freeSpaceEdgeMargin;
+        /** A free-space triangle whose 3D plane agrees with those of its three neighbours within
+        this angle (degrees) lies on one facade, not across a corner: its free space follows its
+        plane (the depth interpolated over the triangle) up to 3 voxels before it, instead of
+        stopping at its nearest corner less the edge margin (default 30; 0 = every triangle flat
+        at its nearest corner). A triangle across a right-angled corner is about 45 degrees from
+        its neighbours on the facades. Such triangles are kept however long (the rule that drops
+        triangles over twice the frame's median edge, which may span a notch, is for the others).
+        Measured in doc/clones.md. */
+        double freeSpacePlanarDeg;
+        /** Voxels in vertical runs (along the grid axis nearest the vertical the cameras give) of
+        which no frame shows a single voxel, behind other objects or the object's own near side
+        in every frame, are removed (default true): a hidden wedge of the visual hull, which no
+        composite of the video shows but the object's matte as if alone does. Measured in
+        doc/clones.md. */
+        bool dropUnobserved;
     };
 
     static Ptr<CloneBuilder> create(const Params& params);
