@@ -337,5 +337,64 @@ TEST(Augocc_SfmSynth, perspective_scene)
     EXPECT_EQ("perspective", autoRep.chosenModel);
 }
 
+// Tracks the factorization rejects against its affine model but the final perspective cameras
+// explain come back (hand-held footage near the buildings: the camera three scene sizes away),
+// and no outlier track with them. Measured 2026-12-01 (40% partial tracks, 5% outliers): 41
+// rescued, 0 of them outliers; error after alignment (scene units, the scene about 5 across):
+// rescued median 0.017, max 0.075; kept median 0.014, 95th percentile 0.070. Bound: the rescued
+// median within the kept points' 95th percentile. The 3 of 30 outliers that stay were
+// kept by the factorization itself (random walks that barely move look like points near the
+// orbit's centre). On the perspective demo's own tracks 41 of 92 rejected tracks came back.
+TEST(Augocc_SfmSynth, perspective_rejected_tracks_rescued)
+{
+    SceneSynthesizer::Params sp;
+    sp.model = PERSPECTIVE;
+    sp.distanceRatio = 3;
+    sp.partialFraction = 0.4;
+    sp.outlierFraction = 0.05;
+    SyntheticScene scene;
+    SceneSynthesizer::create(sp)->synthesize(scene);
+    SfmOptions opt;
+    opt.model = "perspective";
+    SfmReport rep;
+    const Reconstruction rec = recoverCameras(scene.tracks, opt, &rep);
+    Reconstruction rec0;
+    Mat inliers;
+    ASSERT_TRUE(FactorizationSfM::create()->reconstruct(scene.tracks, rec0, inliers));
+    const Matx44d M = alignReconstructions(rec, scene.groundTruth);
+    int rescued = 0, outRescued = 0;
+    std::vector<double> err, errR;
+    for (int p = 0; p < scene.tracks.points(); p++)
+    {
+        const double* X = rec.points.ptr<double>(p);
+        if (!std::isfinite(X[0]) || scene.outlierTrack[p])
+        {
+            outRescued += std::isfinite(X[0]) && !inliers.at<uchar>(p);
+            continue;
+        }
+        const Vec4d Y = M * Vec4d(X[0], X[1], X[2], 1);
+        const double* G = scene.groundTruth.points.ptr<double>(p);
+        const double e = cv::norm(Vec3d(Y[0], Y[1], Y[2]) - Vec3d(G[0], G[1], G[2]));
+        if (inliers.at<uchar>(p))
+            err.push_back(e);
+        else
+        {
+            rescued++;
+            errR.push_back(e);
+        }
+    }
+    ASSERT_GT(rescued, 0);
+    std::sort(err.begin(), err.end());
+    std::sort(errR.begin(), errR.end());
+    const double keptP95 = err[err.size() * 95 / 100], rescuedMedian = errR[errR.size() / 2];
+    std::cout << "perspective at 3x, 40% partial + 5% outliers: rescued " << rep.rescuedTracks
+              << " tracks (" << outRescued << " outliers); error after alignment (units): "
+              << "rescued median " << rescuedMedian << " max " << errR.back() << ", kept median "
+              << err[err.size() / 2] << " p95 " << keptP95 << " max " << err.back() << std::endl;
+    EXPECT_EQ(rep.rescuedTracks, rescued + outRescued);
+    EXPECT_EQ(outRescued, 0);
+    EXPECT_LE(rescuedMedian, keptP95);
+}
+
 } // namespace
 } // namespace opencv_test

@@ -56,9 +56,10 @@ void registerSfm(CLI::App& app, Globals& g)
             cv::augocc::writeColmapModel(args->colmap, rec, tracks);
         if (!args->ply.empty())
             cv::augocc::writePointsPly(args->ply, rec);
-        info(g, cv::format("sfm: %d frames, %d tracks kept, %d rejected; model %s",
-                           (int)rec.cameras.size(), rep.inlierTracks, rep.rejectedTracks,
-                           rep.chosenModel.c_str()));
+        info(g, cv::format("sfm: %d frames, %d tracks kept (%d of them rejected by the "
+                           "factorization and explained by the final cameras), %d rejected; "
+                           "model %s", (int)rec.cameras.size(), rep.inlierTracks,
+                           rep.rescuedTracks, rep.rejectedTracks, rep.chosenModel.c_str()));
         info(g, "  factorization:       " + statsLine(rep.factorization));
         info(g, "  3F+1 refinement:     " + statsLine(rep.positionZoom));
         if (opt.bundleAdjust)

@@ -123,6 +123,9 @@ struct CV_EXPORTS SfmReport
 {
     int inlierTracks = 0;             //!< tracks kept (finite points)
     int rejectedTracks = 0;           //!< tracks rejected as outliers or unusable
+    //! of the tracks the factorization rejected, those the final cameras explain (counted in
+    //! inlierTracks)
+    int rescuedTracks = 0;
     ReprojectionStats factorization;  //!< after the factorization
     ReprojectionStats positionZoom;   //!< after the paper's 3F+1
     ReprojectionStats orthographic;   //!< after the scaled-orthographic BA (if run)
