@@ -79,7 +79,7 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
     struct Tri
     {
         int v[3];
-        double edge = 0, zmin = 0;
+        double edge = 0, zmin = 0, minCos = 1;
         Vec3d normal;
         bool planar = false;
     };
@@ -113,8 +113,10 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
     // A triangle is planar when it and the three triangles across its edges lie on one plane
     // (normals within params.planarDeg): on a facade, not spanning a corner. Its free space
     // follows its plane (depth interpolated over the triangle, 1/z under perspective) less
-    // marginVoxels; the others stay flat at their nearest vertex less the edge margin (a triangle
-    // that spans a convex corner passes in front of the corner by up to about half its edge).
+    // marginVoxels, or less the bulge of a curved surface (half its edge times the sine of the
+    // largest angle to its neighbours) when that is more; the others stay flat at their nearest
+    // vertex less the edge margin (a triangle that spans a convex corner passes in front of the
+    // corner by up to about half its edge).
     std::map<std::pair<int, int>, std::vector<int> > byEdge;
     for (size_t q = 0; q < keep.size(); q++)
         for (int c = 0; c < 3; c++)
@@ -137,7 +139,9 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
                 if (o != (int)q)
                 {
                     across++;
-                    planar = std::abs(keep[o].normal.dot(t.normal)) >= cosPlanar;
+                    const double c = std::abs(keep[o].normal.dot(t.normal));
+                    t.minCos = std::min(t.minCos, c);
+                    planar = c >= cosPlanar;
                 }
         }
         t.planar = planar && across == 3;
@@ -189,7 +193,11 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
     {
         if (!t.planar)
             continue;
-        const double margin = params.marginVoxels * h;
+        // A curved surface bulges in front of the chord plane by about half the edge times the
+        // angle it turns through to the neighbours (sin of it here): that much margin too.
+        const double sinTurn = std::sqrt(std::max(0.0, 1 - t.minCos * t.minCos));
+        const double margin = std::max(params.marginVoxels * h,
+                                       0.5 * t.edge * sinTurn / cam.pixelsPerUnit(t.zmin));
         const Point2d A(px[t.v[0]]), B(px[t.v[1]]), C(px[t.v[2]]);
         const double det = (B.x - A.x) * (C.y - A.y) - (C.x - A.x) * (B.y - A.y);
         if (std::abs(det) < 1e-9)
