@@ -63,6 +63,20 @@ struct Box
         return toWorld(Vec3d(c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]));
     }
     Vec3d centre() const { return toWorld(0.5 * (lo + hi)); }
+    //! Box coordinates b clamped into the box.
+    Vec3d clamp(const Vec3d& b) const
+    {
+        Vec3d c;
+        for (int a = 0; a < 3; a++)
+            c[a] = std::min(std::max(b[a], lo[a]), hi[a]);
+        return c;
+    }
+    //! Distance from world point X to the box (0 inside).
+    double distance(const Vec3d& X) const
+    {
+        const Vec3d b = toBox(X);
+        return cv::norm(b - clamp(b));
+    }
 };
 
 struct ObjectWork
@@ -808,22 +822,6 @@ const double kGrowReach = 0.5;
 // Candidates per ray whose path to the box is checked, nearest first.
 const int kGrowMaxCandidates = 8;
 
-// Box coordinates b clamped into the box.
-Vec3d clampToBox(const Box& box, const Vec3d& b)
-{
-    Vec3d c;
-    for (int a = 0; a < 3; a++)
-        c[a] = std::min(std::max(b[a], box.lo[a]), box.hi[a]);
-    return c;
-}
-
-// Distance from world point X to the box (0 inside).
-double outsideDistance(const Box& box, const Vec3d& X)
-{
-    const Vec3d b = box.toBox(X);
-    return cv::norm(b - clampToBox(box, b));
-}
-
 std::vector<Vec3d> hullPointsOutsideBox(const Box& box, const ObjectClone& obj,
                                         const Reconstruction& rec)
 {
@@ -860,7 +858,7 @@ std::vector<Vec3d> hullPointsOutsideBox(const Box& box, const ObjectClone& obj,
         for (int q = r.start; q < r.end; q++)
         {
             const Camera& cam = rec.camera(keys[q]);
-            const Mat& sil = obj.masks.at(keys[q]);
+            const Mat& sil = *sils[q];
             // Over the silhouette's bounding box (and a ring, so that the outline's distance is
             // right at the box's border).
             const Rect roi = Rect(boundingRect(sil) + Size(2, 2) - Point(1, 1)) &
@@ -902,7 +900,7 @@ std::vector<Vec3d> hullPointsOutsideBox(const Box& box, const ObjectClone& obj,
                 for (double t = t0; t <= t1; t += step)
                 {
                     const Vec3d X = ray.at(t);
-                    const double dist = outsideDistance(box, X);
+                    const double dist = box.distance(X);
                     if (dist > 0 && dist < kGrowReach * diag && inSilhouettes(X, (int)q))
                         cand.push_back(std::make_pair(dist, X));
                 }
@@ -915,7 +913,7 @@ std::vector<Vec3d> hullPointsOutsideBox(const Box& box, const ObjectClone& obj,
                 for (size_t c = 0; c < cand.size() && c < (size_t)kGrowMaxCandidates; c++)
                 {
                     const Vec3d X = cand[c].second;
-                    const Vec3d B = box.toWorld(clampToBox(box, box.toBox(X)));
+                    const Vec3d B = box.toWorld(box.clamp(box.toBox(X)));
                     const int n = (int)std::ceil(cv::norm(X - B) / step);
                     bool connected = true;
                     for (int k = 1; k < n && connected; k++)
@@ -1050,25 +1048,13 @@ std::map<String, int64> dropUnobservedRuns(std::map<String, ObjectClone>& objs,
             }
         }
     });
-    std::map<String, std::vector<uchar> > seen;
+    const Vec3d up = estimateVertical(rec);
     for (size_t n = 0; n < names.size(); n++)
     {
-        const ObjectClone& obj = objs.at(names[n]);
-        std::vector<uchar>& sn = seen[names[n]];
-        sn.assign(obj.grid.data.size(), 0);
-        for (size_t ci = 0; ci < cams.size(); ci++)
-            for (uint32_t q : seenIn[ci][n])
-            {
-                int i, j, k;
-                unpackVoxel(obj.surface.ijk[q], i, j, k);
-                sn[obj.grid.index(i, j, k)] = 1;
-            }
-    }
-    const Vec3d up = estimateVertical(rec);
-    for (auto& o : objs)
-    {
-        VoxelGrid& g = o.second.grid;
-        removed[o.first] = 0;
+        ObjectClone& obj = objs.at(names[n]);
+        VoxelGrid& g = obj.grid;
+        int64& count = removed[names[n]];
+        count = 0;
         if (g.empty())
             continue;
         int axis = 0;
@@ -1084,7 +1070,14 @@ std::map<String, int64> dropUnobservedRuns(std::map<String, ObjectClone>& objs,
         }
         if (best < std::cos(kMaxRunTiltDeg * CV_PI / 180))
             continue;
-        const std::vector<uchar>& sn = seen[o.first];
+        std::vector<uchar> sn(g.data.size(), 0);
+        for (size_t ci = 0; ci < cams.size(); ci++)
+            for (uint32_t q : seenIn[ci][n])
+            {
+                int i, j, k;
+                unpackVoxel(obj.surface.ijk[q], i, j, k);
+                sn[g.index(i, j, k)] = 1;
+            }
         const int u = (axis + 1) % 3, v = (axis + 2) % 3;
         std::vector<int64> perSlice(g.dims[v], 0);
         parallel_for_(Range(0, g.dims[v]), [&](const Range& r) {
@@ -1127,10 +1120,10 @@ std::map<String, int64> dropUnobservedRuns(std::map<String, ObjectClone>& objs,
                     }
                 }
         });
-        for (int64 n : perSlice)
-            removed[o.first] += n;
-        if (removed[o.first] > 0)
-            o.second.surface = g.surface();
+        for (int64 c : perSlice)
+            count += c;
+        if (count > 0)
+            obj.surface = g.surface();
     }
     return removed;
 }

@@ -10,8 +10,9 @@
 // Delaunay triangles of an object's points in the image: a triangle is taken as empty in front
 // of its nearest corner, less a margin that grows with its size (a triangle that spans a convex
 // corner passes in front of the corner); a triangle on one plane with its three neighbours (a
-// facade) in front of its own plane, less a margin of a few voxels. The visual hull from a narrow orbit is deep along the
-// lines of sight (a box seen over 50 degrees keeps a wedge in front of its facade) and fills
+// facade) in front of its own plane, less a margin of a few voxels. The visual hull from a
+// narrow orbit is deep along the lines of sight (a box seen over 50 degrees keeps a wedge in
+// front of its facade) and fills
 // concavities (an L-shaped block's inner corner); these phantoms hide virtual objects that
 // stand in front of the real ones, and free space removes them where the object has texture.
 // Only each object's own points (Step 1) carve its grid, so a featureless object in front of a
@@ -139,9 +140,9 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
                 if (o != (int)q)
                 {
                     across++;
-                    const double c = std::abs(keep[o].normal.dot(t.normal));
-                    t.minCos = std::min(t.minCos, c);
-                    planar = c >= cosPlanar;
+                    const double cosN = std::abs(keep[o].normal.dot(t.normal));
+                    t.minCos = std::min(t.minCos, cosN);
+                    planar = cosN >= cosPlanar;
                 }
         }
         t.planar = planar && across == 3;
