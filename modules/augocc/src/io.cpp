@@ -256,14 +256,19 @@ const Camera& Reconstruction::camera(int frame) const
     return cameras[i];
 }
 
+bool Reconstruction::hasPoint(int p) const
+{
+    if (p < 0 || p >= points.rows)
+        return false;
+    const double* X = points.ptr<double>(p);
+    return std::isfinite(X[0]) && std::isfinite(X[1]) && std::isfinite(X[2]);
+}
+
 int Reconstruction::validPointCount() const
 {
     int n = 0;
     for (int i = 0; i < points.rows; i++)
-    {
-        const double* p = points.ptr<double>(i);
-        n += (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) ? 1 : 0;
-    }
+        n += hasPoint(i) ? 1 : 0;
     return n;
 }
 

@@ -60,7 +60,12 @@ struct CV_EXPORTS Reconstruction
     const Camera& camera(int frame) const;
     //! Projects a world point into frame `frame`.
     Point2d project(int frame, const Vec3d& Xw) const { return camera(frame).project(Xw); }
-    //! Number of points whose row is finite.
+    //! True when track column `p` has a reconstructed point: row `p` of `points` exists and all
+    //! three coordinates are finite (rejected and unreconstructed tracks are rows of NaN).
+    bool hasPoint(int p) const;
+    //! Point of track column `p` (check hasPoint() first).
+    Vec3d point(int p) const { return Vec3d(points.ptr<double>(p)); }
+    //! Number of points for which hasPoint() holds.
     int validPointCount() const;
     //! Throws on any inconsistency (model mix, frame order, R not a rotation, s <= 0, bad shapes).
     void validate(const String& what = String()) const;
