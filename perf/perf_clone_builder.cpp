@@ -2,7 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "perf_precomp.hpp"
-#include "clone_internal.hpp"
+#include "clone/passes.hpp"
 
 #include <cstdio>
 #include <sys/resource.h>
@@ -85,7 +85,7 @@ const CloneProblem& problem()
     p.grid.create(Vec3i(256, 256, 256), Matx33d::eye(), Vec3d(-128, -128, -128), 1.0, 1);
     // The 256^3 clone itself (carved, with patches) for the render and I/O benchmarks.
     Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
-    ObjectClone& o = set->objects["block"];
+    ObjectClone& o = set->add("block");
     o.name = "block";
     o.grid = p.grid;
     o.centre = Vec3d(0, 0, 0);
@@ -134,7 +134,7 @@ void Augocc_CloneBuilder_patches(benchmark::State& state)
 {
     const CloneProblem& p = problem();
     const CloneSetImpl& set = dynamic_cast<const CloneSetImpl&>(*p.clones);
-    const ObjectClone& obj = set.objects.at("block");
+    const ObjectClone& obj = set.get("block");
     const int f = 3;
     size_t n = 0;
     for (auto _ : state)
@@ -166,7 +166,7 @@ void Augocc_CloneSet_render(benchmark::State& state)
     if (countNonZero(matte) == 0)
         state.SkipWithError("empty matte");
     const CloneSetImpl& set = dynamic_cast<const CloneSetImpl&>(*p.clones);
-    state.counters["surface_voxels"] = (double)set.objects.at("block").surface.size();
+    state.counters["surface_voxels"] = (double)set.get("block").surface.size();
 }
 BENCHMARK(Augocc_CloneSet_render)->Name("Augocc_CloneSet/render_matte_depth_640x480")
     ->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -224,7 +224,7 @@ void Augocc_CloneBuilder_build_synth(benchmark::State& state)
     const RefineProblem& p = refineProblem();
     CloneBuilder::Params params;
     if (state.range(0) == 0)
-        params.freeSpaceMinViews = 0;
+        params.freeSpace.minViews = 0;
     Ptr<CloneBuilder> b = CloneBuilder::create(params);
     int64 voxels = 0;
     for (auto _ : state)
@@ -265,7 +265,7 @@ void Augocc_CloneBuilder_refine_256(benchmark::State& state)
         carved = b->refine(set, rec, frames);
     }
     state.counters["carved"] = (double)carved;
-    state.counters["grid_voxels"] = (double)base.objects.at("block").grid.total();
+    state.counters["grid_voxels"] = (double)base.get("block").grid.total();
 }
 BENCHMARK(Augocc_CloneBuilder_refine_256)
     ->Name("Augocc_CloneBuilder/refine_256_60frames_640x480_consistent")

@@ -3,7 +3,7 @@
 
 #include "test_precomp.hpp"
 #include "voxel_grid.hpp"
-#include "clone_codec.hpp"
+#include "clone/clone_codec.hpp"
 
 namespace opencv_test {
 namespace {

@@ -14,8 +14,7 @@ struct CloneOptions
 {
     std::string reconstruction, masks, out, tracks, orientation, ply, input,
         patchRule = "nearest";
-    double voxelPixels = 1.0;
-    int raysPerPixel = 2;
+    cv::augocc::CloneBuilder::Params params;  // --voxel-pixels, --rays-per-pixel
     bool noOcclusion = false;
     bool noFreeSpace = false;
 };
@@ -39,20 +38,18 @@ void runClone(const CloneOptions& o, const Globals& g)
         requireFile("--tracks", o.tracks);
     if (!o.input.empty() && o.input.find('%') == std::string::npos)
         requireFile("--input", o.input);
-    CloneBuilder::Params p;
-    p.voxelPixels = o.voxelPixels;
-    p.raysPerPixel = o.raysPerPixel;
+    CloneBuilder::Params p = o.params;
     p.occlusionAware = !o.noOcclusion;
     if (o.noFreeSpace)
-        p.freeSpaceMinViews = 0;
+        p.freeSpace.minViews = 0;
     if (o.patchRule == "bracketing")
-        p.patchRule = CloneBuilder::PATCH_BRACKETING;
+        p.patches.rule = CloneBuilder::PATCH_BRACKETING;
     else if (o.patchRule != "nearest")
         throw UsageError("--patch-rule " + o.patchRule + ": expected nearest or bracketing");
     if (!o.orientation.empty())
     {
-        p.orientation = CloneBuilder::ORIENT_USER;
-        p.userRotation = parseOrientation(o.orientation);
+        p.box.orientation = CloneBuilder::ORIENT_USER;
+        p.box.userRotation = parseOrientation(o.orientation);
     }
     const Reconstruction rec = readReconstruction(o.reconstruction);
     const ObjectMasks masks = readMasks(o.masks, rec.imageSize);
@@ -123,9 +120,10 @@ void registerClone(CLI::App& app, Globals& g)
     sub->add_option("--input", o->input, "the video (or image folder, printf pattern): carve the "
                     "clones further by photo-consistency over every frame with a camera");
     sub->add_option("--ply", o->ply, "also write PLY files of each clone and patch set here");
-    sub->add_option("--voxel-pixels", o->voxelPixels, "voxel edge in pixels (default 1)");
-    sub->add_option("--rays-per-pixel", o->raysPerPixel, "patch rays per pixel along each axis "
-                    "(default 2)");
+    sub->add_option("--voxel-pixels", o->params.voxelPixels, "voxel edge in pixels")
+        ->capture_default_str();
+    sub->add_option("--rays-per-pixel", o->params.patches.raysPerPixel, "patch rays per pixel "
+                    "along each axis")->capture_default_str();
     sub->add_option("--patch-rule", o->patchRule, "patches for frames between key frames: "
                     "nearest (default) or bracketing");
     sub->add_flag("--no-occlusion", o->noOcclusion, "carve under nearer objects' silhouettes too "

@@ -12,7 +12,8 @@
 
 /*
 The one voxel grid of the module (DESIGN.md): dense, one byte per voxel, a rigid box pose, carving
-against silhouettes, surface extraction and footprint splatting (matte + depth). File encoding: clone_codec.hpp.
+against silhouettes, surface extraction and footprint splatting (matte + depth). File encoding:
+clone/clone_codec.hpp.
 
 Voxel (i, j, k) is the cube of edge h centred at origin + Rbox * (h * (i + 0.5, j + 0.5, k + 0.5)).
 Its FOOTPRINT in an image is the set of pixel centres inside the bounding rectangle of its

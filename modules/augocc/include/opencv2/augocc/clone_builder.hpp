@@ -93,7 +93,7 @@ public:
     {
         ORIENT_AUTO = 0,  //!< vertical from the cameras' horizontal x axes, then least footprint
         ORIENT_WORLD = 1, //!< the reconstruction's axes (the paper's initial box)
-        ORIENT_USER = 2   //!< Params::userRotation (the paper's interactive rotation)
+        ORIENT_USER = 2   //!< BoxParams::userRotation (the paper's interactive rotation)
     };
     //! Which key frames' patch voxels apply to a frame that is not a key frame.
     enum PatchRule
@@ -102,86 +102,128 @@ public:
         PATCH_BRACKETING = 1 //!< both key frames around the frame (the nearest outside the range)
     };
 
+    //! Steps 1-3: the box that holds the object, from its points and its silhouettes.
+    struct CV_EXPORTS BoxParams
+    {
+        //! Step 1: fewer clustered points than this and the box comes from the silhouettes alone.
+        int minPoints = 4;
+        //! Step 1: fraction of the points trimmed at each end of every box axis, in [0, 0.5).
+        //! Higher gives a smaller box for Step 3 to enlarge.
+        double trimFraction = 0.02;
+        //! Step 2: an Orientation.
+        int orientation = ORIENT_AUTO;
+        //! ORIENT_USER: Rodrigues vector (radians) of the box axes in world coordinates.
+        Vec3d userRotation = Vec3d(0, 0, 0);
+        //! Step 3: at most this many passes over the key frames while enlarging the box.
+        int maxEnlargeIterations = 20;
+    };
+
+    //! Step 5: patch voxels, per key frame, that make the clone cover its silhouette exactly.
+    struct CV_EXPORTS PatchParams
+    {
+        //! Rays per pixel along each image axis (n x n per pixel), in [1, 8]. Higher misses
+        //! fewer voxels along a pixel's footprint, at n^2 the cost.
+        int raysPerPixel = 2;
+        //! A PatchRule: whose patch voxels a frame that is not a key frame shows.
+        int rule = PATCH_NEAREST;
+    };
+
+    /** @brief Free-space carving from the tracks (beyond the paper; build() with tracks).
+
+    A point tracked in a frame is seen there, so in that frame the Delaunay triangles (in the
+    image) between an object's points are empty in front of their nearest corner, less a margin of
+    marginVoxels voxel edges or edgeMargin times the triangle's longest edge, whichever is larger.
+    A voxel that at least minViews frames show free goes (peeled from the surface; never one a
+    key-frame silhouette pixel needs). */
+    struct CV_EXPORTS FreeSpaceParams
+    {
+        //! A voxel goes when at least this many frames show it free; 0 turns the pass off.
+        //! Lower carves more.
+        int minViews = 2;
+        //! Margin per pixel of triangle edge, as a fraction of the triangle's longest edge: a
+        //! triangle spanning a convex corner passes in front of it by up to about half its edge.
+        //! Lower carves closer to flat facades.
+        double edgeMargin = 0.5;
+        /** A triangle whose 3D plane agrees with those of its three neighbours within this angle
+        (degrees, in [0, 90]) lies on one facade: its free space follows its plane (the depth
+        interpolated over the triangle) up to marginVoxels before it, instead of stopping at its
+        nearest corner less the edge margin. 0: every triangle flat at its nearest corner. A
+        triangle across a right-angled corner is about 45 degrees from its neighbours. Such
+        triangles are kept however long (maxEdgeRatio is for the others). Higher carves more. */
+        double planarDeg = 30;
+        //! Free space ends at least this many voxel edges before the points. Lower carves more.
+        double marginVoxels = 3;
+        //! Triangles longer than this times the frame's median edge (which may span a gap or a
+        //! notch) are not used, planar ones aside. Higher carves more.
+        double maxEdgeRatio = 2;
+        //! Observations farther than this (pixels) from their point's projection (a track that
+        //! slid along an occluding contour) are not used.
+        double maxReprojPx = 2;
+        //! At most this many frames are used, evenly spaced over the cameras; 0: every frame.
+        int maxViews = 30;
+    };
+
+    /** @brief What no frame sees (beyond the paper): voxels in vertical runs (along the grid axis
+    nearest the vertical the cameras give) of which no frame shows a single voxel, behind other
+    objects or the object's own near side in every frame, are removed: a hidden wedge of the
+    visual hull, which no composite of the video shows but the object's matte as if alone does. */
+    struct CV_EXPORTS UnobservedParams
+    {
+        //! Whether the pass runs.
+        bool enabled = true;
+        //! Frames asked, evenly spaced over the cameras (every key frame is asked too).
+        int views = 30;
+        //! A surface voxel is seen when its centre is within this many voxel edges of the nearest
+        //! clone depth at its pixel. Higher removes less.
+        double depthTolVoxels = 1.5;
+        //! The vertical must be within this angle (degrees) of a grid axis for the runs to follow
+        //! it; else the pass leaves the object alone.
+        double maxTiltDeg = 20;
+    };
+
+    /** @brief refine(): photo-consistency carving over the video's frames (space carving
+    @cite Kutulakos2000 with voxel colouring's visibility @cite Seitz1999). */
+    struct CV_EXPORTS PhotoParams
+    {
+        /** A view agrees with a voxel's colour (the per-channel median over the views that see
+        it) when a pixel of the 3x3 neighbourhood of the voxel's centre differs from it by at
+        most this many grey levels in every channel, after an exposure gain within 10% (8-bit
+        frames, in [0, 255]). Lower carves more. */
+        double threshold = 15;
+        //! A voxel is photo-consistent when at least this fraction of the views that see it
+        //! agree, in (0, 1]. Higher carves more.
+        double minAgreement = 0.95;
+        //! A voxel seen in fewer frames than this is kept (no evidence), at least 2.
+        int minViews = 4;
+        //! Rounds of the six plane sweeps, each with the visibility the last left.
+        int rounds = 1;
+        /** 0 compares the voxel's centre pixel only; s > 0 (at most 8) also the four pixels s
+        away along the image axes, each against its own median (a sparse patch: carves phantoms
+        in front of uniform bands, but erodes true edges where the patch straddles an occluding
+        contour). */
+        int patchStep = 0;
+        //! At most this many frames are compared, evenly spaced over the cameras of the
+        //! reconstruction; 0: every frame (else at least minViews).
+        int maxViews = 24;
+    };
+
+    /** @brief The builder's parameters: the voxel size and key-frame rule shared by every pass,
+    then one part per pass (see doc/clones.md for the figures behind each default). */
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        //! Voxel edge in pixels of the key frame that sees the object largest (default 1: a voxel
-        //! projects to at most about one pixel, the paper's rule).
-        double voxelPixels;
-        //! Upper bound on voxels per object; the voxel grows to respect it (default 2^27).
-        int64 maxVoxels;
-        //! Step 3: passes over the key frames while enlarging the box (default 20).
-        int maxEnlargeIterations;
-        //! Step 2: Orientation (default ORIENT_AUTO).
-        int orientation;
-        //! ORIENT_USER: Rodrigues vector (radians) of the box axes in world coordinates.
-        Vec3d userRotation;
-        //! Step 5: rays per pixel along each image axis, n x n per pixel (default 2).
-        int raysPerPixel;
-        //! PatchRule for frames that are not key frames (default PATCH_NEAREST).
-        int patchRule;
-        //! Step 4: pixels under a nearer object's silhouette are unknown, not outside (default true).
-        bool occlusionAware;
-        //! Step 1: fraction of points trimmed at each end of every box axis (default 0.02).
-        double trimFraction;
-        //! Step 1: fewer clustered points than this and the box comes from the silhouettes alone
-        //! (default 4).
-        int minPoints;
-        /** refine(): a view agrees with a voxel's colour (the per-channel median over the views
-        that see it) when a pixel of the 3x3 neighbourhood of the voxel's centre differs from it
-        by at most this many grey levels in every channel, after an exposure gain within 10%
-        (default 15; 8-bit frames). Lower carves more. */
-        double photoThreshold;
-        /** refine(): a voxel is photo-consistent when at least this fraction of the views that
-        see it agree (default 0.95: a voxel goes when more than 5% of its views contradict it).
-        Higher carves more. */
-        double photoMinAgreement;
-        /** refine(): a voxel seen in fewer frames than this is kept (no evidence) (default 4:
-        with photoMinAgreement 0.95 all four must agree; a sweep over 16 views on a ring, as in
-        Middlebury's dinoSparseRing, has 5 to 7 cameras). */
-        int photoMinViews;
-        //! refine(): rounds of the six plane sweeps, each with the visibility the last left
-        //! (default 1: a second round carved about 1% more on the synthesized scene).
-        int photoRounds;
-        /** refine(): 0 compares the voxel's centre pixel only (default); s > 0 also the four
-        pixels s away along the image axes, each against its own median (a sparse patch: carves
-        phantoms in front of uniform bands, but erodes true edges where the patch straddles an
-        occluding contour; measured in doc/clones.md). */
-        int photoPatchStep;
-        /** refine(): at most this many frames are compared, evenly spaced over the cameras of
-        the reconstruction (default 24; 0 = every frame). Neighbouring frames of a video add
-        little evidence: on the synthesized 60-frame scene 24 views gave the same IoUs as all 60
-        (L-block depth error 37.1 voxels instead of 35.4; 42.4 unrefined) and `augocc run` on 100
-        frames spent 1.4 s instead of 4.4 s in the clone stage. */
-        int photoMaxViews;
-        /** build() with tracks, free-space carving beyond the paper: a point tracked in a frame
-        is seen there, so in that frame the triangles (Delaunay, in the image) between an
-        object's points are empty in front of their nearest corner, by a margin of 3 voxels or
-        freeSpaceEdgeMargin times the triangle's longest edge, whichever is larger. A voxel that
-        at least this many frames show free goes (peeled from the surface; never one a key-frame
-        silhouette pixel needs). Carves the visual hull's depth phantoms that silhouettes from a
-        narrow orbit leave in front of facades and in concavities (default 2; 0 = off; measured
-        in doc/clones.md). */
-        int freeSpaceMinViews;
-        /** Free-space margin per pixel of triangle edge, as a fraction of the edge (default 0.5):
-        a triangle spanning a convex corner passes in front of the corner by up to about half its
-        edge, which the margin keeps. Lower carves closer to flat facades. */
-        double freeSpaceEdgeMargin;
-        /** A free-space triangle whose 3D plane agrees with those of its three neighbours within
-        this angle (degrees) lies on one facade, not across a corner: its free space follows its
-        plane (the depth interpolated over the triangle) up to 3 voxels before it, instead of
-        stopping at its nearest corner less the edge margin (default 30; 0 = every triangle flat
-        at its nearest corner). A triangle across a right-angled corner is about 45 degrees from
-        its neighbours on the facades. Such triangles are kept however long (the rule that drops
-        triangles over twice the frame's median edge, which may span a notch, is for the others).
-        Measured in doc/clones.md. */
-        double freeSpacePlanarDeg;
-        /** Voxels in vertical runs (along the grid axis nearest the vertical the cameras give) of
-        which no frame shows a single voxel, behind other objects or the object's own near side
-        in every frame, are removed (default true): a hidden wedge of the visual hull, which no
-        composite of the video shows but the object's matte as if alone does. Measured in
-        doc/clones.md. */
-        bool dropUnobserved;
+        //! Voxel edge in pixels of the key frame that sees the object largest (1: a voxel
+        //! projects to at most about one pixel, the paper's rule). Lower gives finer clones.
+        double voxelPixels = 1.0;
+        //! Upper bound on voxels per object; the voxel grows to respect it.
+        int64 maxVoxels = (int64)1 << 27;
+        //! Steps 4 and 5: pixels under a nearer object's silhouette are unknown, not outside, so
+        //! a building in front does not bite a hole in the one behind.
+        bool occlusionAware = true;
+        BoxParams box;              //!< Steps 1-3
+        PatchParams patches;        //!< Step 5
+        FreeSpaceParams freeSpace;  //!< build() with tracks
+        UnobservedParams unobserved;
+        PhotoParams photo;          //!< refine()
     };
 
     static Ptr<CloneBuilder> create(const Params& params);
@@ -198,7 +240,7 @@ public:
     the reconstruction's image size).
     @param tracks optional: the tracks `rec.points` came from; when given, a point is clustered by
     the key frames in which its track is observed, else by every key frame where it projects, and
-    the clones are carved further by the free space the tracks show (Params::freeSpaceMinViews).
+    the clones are carved further by the free space the tracks show (Params::freeSpace).
     @return the clone set.
     Throws StsBadArg / StsBadSize naming the object and frame for an empty or all-white mask, a mask
     of the wrong size or for a frame with no camera.
@@ -225,8 +267,8 @@ public:
     overhang). Here plane sweeps along the six grid directions visit the surface voxels front to
     back for the cameras that look along the sweep; a voxel's colour is gathered from the frames
     where it is visible (all clones together hide each other, depth tolerance two voxels) and an
-    inconsistent voxel is carved (Params::photoThreshold, photoMinAgreement), which exposes the
-    voxels behind it. Safety: a voxel seen in fewer than Params::photoMinViews frames is kept,
+    inconsistent voxel is carved (PhotoParams::threshold, minAgreement), which exposes the
+    voxels behind it. Safety: a voxel seen in fewer than PhotoParams::minViews frames is kept,
     and no voxel is carved whose removal would leave a pixel of a key-frame silhouette uncovered
     by the model (the user's silhouettes are the truth). Deterministic for any thread count.
     @param clones a set made by build() or CloneSet::load().

@@ -6,10 +6,8 @@
 // @cite Seitz1999, on every frame with a camera, under the key-frame silhouettes' protection.
 
 #include "precomp.hpp"
-#include "clone_internal.hpp"
-#include "key_frame_coverage.hpp"
-
-#include <memory>
+#include "clone/passes.hpp"
+#include "clone/key_frame_coverage.hpp"
 
 namespace cv {
 namespace augocc {
@@ -97,24 +95,8 @@ bool consistent(const std::vector<Point>& px, const std::vector<const Mat*>& img
     return agree >= need;
 }
 
-// Camera data of one object for one round: every frame with a camera.
-struct ObjectViews
-{
-    std::vector<VoxelProjector> proj;
-    std::vector<Rect> roi;       // image rectangle holding every footprint of the grid
-    std::vector<Mat> others;     // CV_32F over roi: nearest depth of the other clones (or empty)
-    std::vector<const Mat*> image;
-};
-
-// One plane sweep of space carving over one object's grid along +-axis `axis` (K&S Section 5.2):
-// planes in order of increasing distance along the sweep, cameras that look along it. A surface
-// voxel is seen in a camera when no kept voxel of an earlier plane (by the ordinal visibility
-// constraint, the only possible occluders) and no other clone covers its centre pixel nearer
-// than the tolerance. Inconsistent voxels go (KeyFrameCoverage permitting); carving exposes the voxels
-// behind them in the plane, which are checked in turn, then the plane's kept surface is drawn
-// into the cameras' cover maps. Returns the number of voxels carved.
 // Cameras that may take part in a sweep along +-axis `axis` of the grid.
-std::vector<int> sweepCameras(const VoxelGrid& g, int axis, int sign, const ObjectViews& ov)
+std::vector<int> sweepCameras(const VoxelGrid& g, int axis, int sign, const PhotoObjectViews& ov)
 {
     std::vector<int> cams;
     for (size_t c = 0; c < ov.proj.size(); c++)
@@ -138,8 +120,16 @@ std::vector<int> sweepCameras(const VoxelGrid& g, int axis, int sign, const Obje
     return cams;
 }
 
+// One plane sweep of space carving over one object's grid along +-axis `axis` (K&S Section 5.2):
+// planes in order of increasing distance along the sweep, cameras that look along it. A surface
+// voxel is seen in a camera when no kept voxel of an earlier plane (by the ordinal visibility
+// constraint, the only possible occluders) and no other clone covers its centre pixel nearer
+// than the tolerance. Inconsistent voxels go (KeyFrameCoverage permitting); carving exposes the
+// voxels behind them in the plane, which are checked in turn, then the plane's kept surface is
+// drawn into the cameras' cover maps. Returns the number of voxels carved.
 int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
-            const ObjectViews& ov, KeyFrameCoverage& cov, const PhotoCarveParams& p)
+            const PhotoObjectViews& ov, KeyFrameCoverage& cov,
+            const CloneBuilder::PhotoParams& p)
 {
     const int nv = (int)cams.size();
     std::vector<Mat> cover(nv);
@@ -311,101 +301,92 @@ int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
 
 } // namespace
 
-std::map<String, int64> photoCarve(CloneSetImpl& set, const Reconstruction& rec,
-                                   const std::vector<Mat>& frames, const PhotoCarveParams& p)
+PhotoViews preparePhotoViews(const CloneSetImpl& clones, const Reconstruction& rec,
+                             const std::vector<Mat>& frames,
+                             const CloneBuilder::PhotoParams& p)
 {
-    const std::vector<String> names = set.objectNames();
+    const std::vector<String> names = clones.objectNames();
+    PhotoViews views;
     // The cameras compared.
-    const std::vector<const Camera*> use = evenlySpacedCameras(rec, p.maxViews);
+    views.cameras = evenlySpacedCameras(rec, p.maxViews);
+    const std::vector<const Camera*>& use = views.cameras;
     const int nc = (int)use.size();
     const int no = (int)names.size();
     const Size size = rec.imageSize;
-    std::map<String, int64> carved;
-    std::vector<std::unique_ptr<KeyFrameCoverage> > cov;
-    for (const String& n : names)
+    std::vector<PhotoObjectViews*> ov(no);
+    for (int o = 0; o < no; o++)
     {
-        ObjectClone& obj = set.get(n);
-        cov.emplace_back(new KeyFrameCoverage(obj.grid, obj, rec));
-        carved[n] = 0;
-    }
-    for (int round = 0; round < p.rounds; round++)
-    {
-        std::vector<ObjectViews> ov(no);
-        for (int o = 0; o < no; o++)
+        const VoxelGrid& g = clones.get(names[o]).grid;
+        PhotoObjectViews& v = views.objects[names[o]];
+        ov[o] = &v;
+        v.proj.resize(nc);
+        v.roi.resize(nc);
+        v.others.resize(nc);
+        v.image.resize(nc);
+        for (int c = 0; c < nc; c++)
         {
-            const VoxelGrid& g = set.get(names[o]).grid;
-            ov[o].proj.resize(nc);
-            ov[o].roi.resize(nc);
-            ov[o].others.resize(nc);
-            ov[o].image.resize(nc);
-            for (int c = 0; c < nc; c++)
-            {
-                ov[o].proj[c] = g.projector(*use[c], size);
-                ov[o].roi[c] = g.imageBounds(ov[o].proj[c]);
-                ov[o].image[c] = &frames[use[c]->frame];
-            }
+            v.proj[c] = g.projector(*use[c], size);
+            v.roi[c] = g.imageBounds(v.proj[c]);
+            v.image[c] = &frames[use[c]->frame];
         }
-        // Objects hide each other: per camera, the nearest depth of the other clones as they
-        // stand (the renderer of the compositor; objects only shrink, so this is conservative).
-        if (no > 1)
-            parallel_for_(Range(0, nc), [&](const Range& r) {
-                std::vector<Mat> depth(no);
-                for (int c = r.start; c < r.end; c++)
+    }
+    // Objects hide each other: per camera, the nearest depth of the other clones as they
+    // stand (the renderer of the compositor; objects only shrink, so this is conservative).
+    if (no > 1)
+        parallel_for_(Range(0, nc), [&](const Range& r) {
+            std::vector<Mat> depth(no);
+            for (int c = r.start; c < r.end; c++)
+            {
+                const Camera& cam = *use[c];
+                for (int o = 0; o < no; o++)
+                    clones.render(names[o], cam.frame, cam, size, noArray(), depth[o]);
+                for (int a = 0; a < no; a++)
                 {
-                    const Camera& cam = *use[c];
+                    const Rect& roi = ov[a]->roi[c];
+                    if (roi.empty())
+                        continue;
+                    Mat m(roi.size(), CV_32F, Scalar(std::numeric_limits<float>::infinity()));
                     for (int o = 0; o < no; o++)
-                        set.render(names[o], cam.frame, cam, size, noArray(), depth[o]);
-                    for (int a = 0; a < no; a++)
-                    {
-                        const Rect& roi = ov[a].roi[c];
-                        if (roi.empty())
-                            continue;
-                        Mat m(roi.size(), CV_32F, Scalar(std::numeric_limits<float>::infinity()));
-                        for (int o = 0; o < no; o++)
-                            if (o != a)
-                                cv::min(m, depth[o](roi), m);
-                        ov[a].others[c] = m;
-                    }
+                        if (o != a)
+                            cv::min(m, depth[o](roi), m);
+                    ov[a]->others[c] = m;
                 }
-            });
-        int64 roundCarved = 0;
-        for (int o = 0; o < no; o++)
-        {
-            ObjectClone& obj = set.get(names[o]);
-            // Sweeps with the most cameras first; the others catch what they expose.
-            std::vector<std::pair<int, int> > order;  // (-cameras, 2 * axis + (sign > 0))
-            std::vector<std::vector<int> > cams(6);
-            for (int d = 0; d < 6; d++)
-            {
-                cams[d] = sweepCameras(obj.grid, d / 2, d % 2 ? 1 : -1, ov[o]);
-                if ((int)cams[d].size() >= p.minViews)
-                    order.push_back(std::make_pair(-(int)cams[d].size(), d));
             }
-            std::sort(order.begin(), order.end());
-            int64 n = 0;
-            std::vector<std::vector<int> > done;
-            for (const auto& d : order)
-            {
-                // Two opposite sweeps can share their cameras (all of them, when the camera
-                // moves little): the second would re-check the same voxels with the same views
-                // and carved about 1% more on the synthesized scene, at the cost of a sweep.
-                if (std::find(done.begin(), done.end(), cams[d.second]) != done.end())
-                    continue;
-                done.push_back(cams[d.second]);
-                n += sweep(obj.grid, d.second / 2, d.second % 2 ? 1 : -1, cams[d.second], ov[o],
-                           *cov[o], p);
-            }
-            if (n > 0)
-                obj.surface = obj.grid.surface();
-            carved[names[o]] += n;
-            roundCarved += n;
-            CV_LOG_DEBUG(NULL, cv::format("augocc: photo-consistency round %d: object '%s': %lld "
-                         "voxels carved", round, names[o].c_str(), (long long)n));
-        }
-        if (roundCarved == 0)
-            break;
+        });
+    return views;
+}
+
+int64 passPhoto(ObjectClone& obj, const PassContext& ctx)
+{
+    const CloneBuilder::PhotoParams& p = ctx.params.photo;
+    const PhotoObjectViews& ov = ctx.photo->objects.at(obj.name);
+    // The key-frame protection, from the surface as it stands (what the last round left).
+    KeyFrameCoverage cov(obj.grid, obj, ctx.rec);
+    // Sweeps with the most cameras first; the others catch what they expose.
+    std::vector<std::pair<int, int> > order;  // (-cameras, 2 * axis + (sign > 0))
+    std::vector<std::vector<int> > cams(6);
+    for (int d = 0; d < 6; d++)
+    {
+        cams[d] = sweepCameras(obj.grid, d / 2, d % 2 ? 1 : -1, ov);
+        if ((int)cams[d].size() >= p.minViews)
+            order.push_back(std::make_pair(-(int)cams[d].size(), d));
     }
-    return carved;
+    std::sort(order.begin(), order.end());
+    int64 n = 0;
+    std::vector<std::vector<int> > done;
+    for (const auto& d : order)
+    {
+        // Two opposite sweeps can share their cameras (all of them, when the camera moves
+        // little): the second would re-check the same voxels with the same views and carved
+        // about 1% more on the synthesized scene, at the cost of a sweep.
+        if (std::find(done.begin(), done.end(), cams[d.second]) != done.end())
+            continue;
+        done.push_back(cams[d.second]);
+        n += sweep(obj.grid, d.second / 2, d.second % 2 ? 1 : -1, cams[d.second], ov, cov, p);
+    }
+    if (n > 0)
+        obj.surface = obj.grid.surface();
+    return n;
 }
 
 } // namespace detail

@@ -7,7 +7,7 @@
 #ifndef OPENCV_AUGOCC_KEY_FRAME_COVERAGE_HPP
 #define OPENCV_AUGOCC_KEY_FRAME_COVERAGE_HPP
 
-#include "clone_internal.hpp"
+#include "clone/clone_set.hpp"
 
 namespace cv {
 namespace augocc {

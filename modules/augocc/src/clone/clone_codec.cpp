@@ -2,7 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "precomp.hpp"
-#include "clone_codec.hpp"
+#include "clone/clone_codec.hpp"
 
 #include <cstring>
 

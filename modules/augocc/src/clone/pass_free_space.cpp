@@ -19,8 +19,8 @@
 // textured one is not carved by the other's triangles.
 
 #include "precomp.hpp"
-#include "clone_internal.hpp"
-#include "key_frame_coverage.hpp"
+#include "clone/passes.hpp"
+#include "clone/key_frame_coverage.hpp"
 
 namespace cv {
 namespace augocc {
@@ -32,7 +32,8 @@ namespace {
 // line of sight is empty (-inf where nothing is known). Observations farther than maxReprojPx
 // from their point's projection (a track that slid along an occluding contour) are left out.
 Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vector<int>& pts,
-                 const Camera& cam, double h, const FreeSpaceParams& params)
+                 const Camera& cam, double h,
+                 const CloneBuilder::FreeSpaceParams& params)
 {
     const int f = cam.frame;
     const Size size = rec.imageSize;
@@ -237,95 +238,87 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
 
 } // namespace
 
-std::map<String, int64> freeSpaceCarve(CloneSetImpl& set, const Reconstruction& rec,
-                                       const Tracks& tracks,
-                                       const std::map<String, std::vector<int> >& members,
-                                       const FreeSpaceParams& params)
+int64 passFreeSpace(ObjectClone& obj, const PassContext& ctx)
 {
-    std::map<String, int64> carved;
-    if (rec.points.empty() || params.minViews <= 0)
-        return carved;
+    const CloneBuilder::FreeSpaceParams& params = ctx.params.freeSpace;
+    const Reconstruction& rec = ctx.rec;
+    if (!ctx.tracks || rec.points.empty() || params.minViews <= 0)
+        return 0;
+    const Tracks& tracks = *ctx.tracks;
     const std::vector<const Camera*> cams = evenlySpacedCameras(rec, params.maxViews);
-    for (auto& o : set.objects)
-    {
-        ObjectClone& obj = o.second;
-        VoxelGrid& g = obj.grid;
-        carved[o.first] = 0;
-        auto mit = members.find(o.first);
-        if (g.empty() || mit == members.end() || mit->second.size() < 3)
-            continue;
-        std::vector<Mat> free(cams.size());
-        std::vector<VoxelProjector> proj(cams.size());
-        parallel_for_(Range(0, (int)cams.size()), [&](const Range& r) {
-            for (int q = r.start; q < r.end; q++)
-            {
-                free[q] = freeDepthMap(rec, tracks, mit->second, *cams[q], g.h, params);
-                proj[q] = g.projector(*cams[q], rec.imageSize);
-            }
-        });
-        // A voxel is free when at least minViews frames' free space holds its centre. Only the
-        // voxels the peel reaches are asked (the surface, then what each carve exposes), in
-        // waves: the wave's answers in parallel, then its carves in order (deterministic).
-        auto isFree = [&](int i, int j, int k) {
-            int votes = 0;
-            for (size_t q = 0; q < proj.size(); q++)
-            {
-                if (free[q].empty())
-                    continue;
-                Point px;
-                if (!proj[q].centrePixel(i, j, k, px) || px.x < 0 || px.y < 0 ||
-                    px.x >= free[q].cols || px.y >= free[q].rows)
-                    continue;
-                const double zv = proj[q].Z.dot(Vec3d(i, j, k)) + proj[q].z0;
-                if (zv < free[q].at<float>(px) && ++votes >= params.minViews)
-                    return true;
-            }
-            return false;
-        };
-        std::vector<uchar> queued(g.data.size(), 0);
-        std::vector<Vec3i> wave;
-        for (uint32_t v : obj.surface.ijk)
+    VoxelGrid& g = obj.grid;
+    if (g.empty() || obj.points.size() < 3)
+        return 0;
+    std::vector<Mat> free(cams.size());
+    std::vector<VoxelProjector> proj(cams.size());
+    parallel_for_(Range(0, (int)cams.size()), [&](const Range& r) {
+        for (int q = r.start; q < r.end; q++)
         {
-            int i, j, k;
-            unpackVoxel(v, i, j, k);
-            wave.push_back(Vec3i(i, j, k));
-            queued[g.index(i, j, k)] = 1;
+            free[q] = freeDepthMap(rec, tracks, obj.points, *cams[q], g.h, params);
+            proj[q] = g.projector(*cams[q], rec.imageSize);
         }
-        KeyFrameCoverage cov(g, obj, rec);
-        int64 n = 0;
-        std::vector<uchar> answer;
-        while (!wave.empty())
+    });
+    // A voxel is free when at least minViews frames' free space holds its centre. Only the
+    // voxels the peel reaches are asked (the surface, then what each carve exposes), in
+    // waves: the wave's answers in parallel, then its carves in order (deterministic).
+    auto isFree = [&](int i, int j, int k) {
+        int votes = 0;
+        for (size_t q = 0; q < proj.size(); q++)
         {
-            answer.assign(wave.size(), 0);
-            parallel_for_(Range(0, (int)wave.size()), [&](const Range& r) {
-                for (int q = r.start; q < r.end; q++)
-                    answer[q] = isFree(wave[q][0], wave[q][1], wave[q][2]);
-            });
-            std::vector<Vec3i> next;
-            for (size_t q = 0; q < wave.size(); q++)
+            if (free[q].empty())
+                continue;
+            Point px;
+            if (!proj[q].centrePixel(i, j, k, px) || px.x < 0 || px.y < 0 ||
+                px.x >= free[q].cols || px.y >= free[q].rows)
+                continue;
+            const double zv = proj[q].Z.dot(Vec3d(i, j, k)) + proj[q].z0;
+            if (zv < free[q].at<float>(px) && ++votes >= params.minViews)
+                return true;
+        }
+        return false;
+    };
+    std::vector<uchar> queued(g.data.size(), 0);
+    std::vector<Vec3i> wave;
+    for (uint32_t v : obj.surface.ijk)
+    {
+        int i, j, k;
+        unpackVoxel(v, i, j, k);
+        wave.push_back(Vec3i(i, j, k));
+        queued[g.index(i, j, k)] = 1;
+    }
+    KeyFrameCoverage cov(g, obj, rec);
+    int64 n = 0;
+    std::vector<uchar> answer;
+    while (!wave.empty())
+    {
+        answer.assign(wave.size(), 0);
+        parallel_for_(Range(0, (int)wave.size()), [&](const Range& r) {
+            for (int q = r.start; q < r.end; q++)
+                answer[q] = isFree(wave[q][0], wave[q][1], wave[q][2]);
+        });
+        std::vector<Vec3i> next;
+        for (size_t q = 0; q < wave.size(); q++)
+        {
+            const Vec3i& v = wave[q];
+            if (!answer[q] || !g.data[g.index(v[0], v[1], v[2])] ||
+                !cov.isSurface(v[0], v[1], v[2]) || !cov.tryCarve(v[0], v[1], v[2]))
+                continue;
+            n++;
+            for (const Vec3i& e : cov.exposed())
             {
-                const Vec3i& v = wave[q];
-                if (!answer[q] || !g.data[g.index(v[0], v[1], v[2])] ||
-                    !cov.isSurface(v[0], v[1], v[2]) || !cov.tryCarve(v[0], v[1], v[2]))
-                    continue;
-                n++;
-                for (const Vec3i& e : cov.exposed())
+                const size_t idx = g.index(e[0], e[1], e[2]);
+                if (!queued[idx])
                 {
-                    const size_t idx = g.index(e[0], e[1], e[2]);
-                    if (!queued[idx])
-                    {
-                        queued[idx] = 1;
-                        next.push_back(e);
-                    }
+                    queued[idx] = 1;
+                    next.push_back(e);
                 }
             }
-            wave.swap(next);
         }
-        if (n > 0)
-            obj.surface = g.surface();
-        carved[o.first] = n;
+        wave.swap(next);
     }
-    return carved;
+    if (n > 0)
+        obj.surface = g.surface();
+    return n;
 }
 
 } // namespace detail

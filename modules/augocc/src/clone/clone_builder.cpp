@@ -1,0 +1,275 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// CloneBuilder: the clone stage's driver. build() runs the passes of clone/passes.hpp in order;
+// each pass is in its own file (pass_*.cpp).
+
+#include "precomp.hpp"
+#include "clone/passes.hpp"
+
+namespace cv {
+namespace augocc {
+
+namespace {
+
+using namespace detail;
+
+void checkMask(const Mat& m, const Reconstruction& rec, const String& object, int frame)
+{
+    const String where = cv::format("masks of object '%s', frame %d", object.c_str(), frame);
+    if (m.empty())
+        CV_Error(Error::StsBadArg, where + ": empty image");
+    if (m.type() != CV_8UC1)
+        CV_Error(Error::StsBadArg, where + ": must be 8-bit single channel");
+    if (m.size() != rec.imageSize)
+        CV_Error(Error::StsBadSize, where + cv::format(": size %dx%d differs from the "
+                 "reconstruction's %dx%d", m.cols, m.rows, rec.imageSize.width,
+                 rec.imageSize.height));
+    if (rec.findCamera(frame) < 0)
+        CV_Error(Error::StsBadArg, where + ": the reconstruction has no camera for this frame");
+    const int n = countNonZero(m > 127);
+    if (n == 0)
+        CV_Error(Error::StsBadArg, where + ": the silhouette is empty");
+    if (n == (int)m.total())
+        CV_Error(Error::StsBadArg, where + ": the silhouette covers the whole frame (all white)");
+}
+
+//! Runs `pass` over every object of `set` in name order and logs what it did to each.
+void runPass(const char* name, int64 (*pass)(ObjectClone&, const PassContext&),
+             CloneSetImpl& set, const PassContext& ctx)
+{
+    for (const String& object : set.objectNames())
+    {
+        const int64 n = pass(set.get(object), ctx);
+        CV_UNUSED(n);  // with the debug log compiled out
+        CV_UNUSED(name);
+        CV_LOG_DEBUG(NULL, cv::format("augocc: clone pass '%s': object '%s': %lld voxels", name,
+                                      object.c_str(), (long long)n));
+    }
+}
+
+CloneSetImpl& cloneSetOf(CloneSet& clones, const char* who)
+{
+    CloneSetImpl* set = dynamic_cast<CloneSetImpl*>(&clones);
+    if (!set)
+        CV_Error(Error::StsBadArg, cv::format("%s: the clone set was not made by CloneBuilder or "
+                                              "CloneSet::load", who));
+    return *set;
+}
+
+class CloneBuilderImpl CV_FINAL : public CloneBuilder
+{
+public:
+    explicit CloneBuilderImpl(const Params& p) { setParams(p); }
+
+    Params getParams() const CV_OVERRIDE { return params_; }
+    void setParams(const Params& p) CV_OVERRIDE;
+
+    Ptr<CloneSet> build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                        const Tracks* tracks) const CV_OVERRIDE;
+    void addKeyFrame(CloneSet& clones, const Reconstruction& rec, const String& object,
+                     int frame, InputArray mask) const CV_OVERRIDE;
+    int64 refine(CloneSet& clones, const Reconstruction& rec,
+                 InputArrayOfArrays frames) const CV_OVERRIDE;
+
+private:
+    Params params_;
+};
+
+void CloneBuilderImpl::setParams(const Params& p)
+{
+    const char* kWhere = "CloneBuilder::Params::";
+    auto check = [&](bool ok, const char* field, const char* rule) {
+        if (!ok)
+            CV_Error(Error::StsBadArg, cv::format("%s%s %s", kWhere, field, rule));
+    };
+    check(p.voxelPixels > 0 && std::isfinite(p.voxelPixels), "voxelPixels", "must be positive");
+    check(p.maxVoxels >= 8, "maxVoxels", "must be at least 8");
+    check(p.box.maxEnlargeIterations >= 1, "box.maxEnlargeIterations", "must be >= 1");
+    check(p.box.orientation >= ORIENT_AUTO && p.box.orientation <= ORIENT_USER,
+          "box.orientation", "is not an Orientation");
+    check(p.box.trimFraction >= 0 && p.box.trimFraction < 0.5, "box.trimFraction",
+          "must be in [0, 0.5)");
+    check(p.box.minPoints >= 1, "box.minPoints", "must be >= 1");
+    check(p.patches.raysPerPixel >= 1 && p.patches.raysPerPixel <= 8, "patches.raysPerPixel",
+          "must be in [1, 8]");
+    check(p.patches.rule == PATCH_NEAREST || p.patches.rule == PATCH_BRACKETING, "patches.rule",
+          "is not a PatchRule");
+    check(p.freeSpace.minViews >= 0, "freeSpace.minViews", "must be >= 0");
+    check(p.freeSpace.edgeMargin >= 0 && std::isfinite(p.freeSpace.edgeMargin),
+          "freeSpace.edgeMargin", "must be >= 0");
+    check(p.freeSpace.planarDeg >= 0 && p.freeSpace.planarDeg <= 90, "freeSpace.planarDeg",
+          "must be in [0, 90]");
+    check(p.freeSpace.marginVoxels >= 0 && std::isfinite(p.freeSpace.marginVoxels),
+          "freeSpace.marginVoxels", "must be >= 0");
+    check(p.freeSpace.maxEdgeRatio > 0, "freeSpace.maxEdgeRatio", "must be positive");
+    check(p.freeSpace.maxReprojPx > 0, "freeSpace.maxReprojPx", "must be positive");
+    check(p.freeSpace.maxViews >= 0, "freeSpace.maxViews", "must be >= 0 (0: every frame)");
+    check(p.unobserved.views >= 1, "unobserved.views", "must be >= 1");
+    check(p.unobserved.depthTolVoxels >= 0 && std::isfinite(p.unobserved.depthTolVoxels),
+          "unobserved.depthTolVoxels", "must be >= 0");
+    check(p.unobserved.maxTiltDeg >= 0 && p.unobserved.maxTiltDeg <= 90,
+          "unobserved.maxTiltDeg", "must be in [0, 90]");
+    check(p.photo.threshold >= 0 && p.photo.threshold <= 255, "photo.threshold",
+          "must be in [0, 255]");
+    check(p.photo.minAgreement > 0 && p.photo.minAgreement <= 1, "photo.minAgreement",
+          "must be in (0, 1]");
+    check(p.photo.minViews >= 2, "photo.minViews", "must be >= 2");
+    check(p.photo.rounds >= 1, "photo.rounds", "must be >= 1");
+    check(p.photo.patchStep >= 0 && p.photo.patchStep <= 8, "photo.patchStep",
+          "must be in [0, 8]");
+    check(p.photo.maxViews == 0 || p.photo.maxViews >= p.photo.minViews, "photo.maxViews",
+          "must be 0 (every frame) or at least photo.minViews");
+    params_ = p;
+}
+
+Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                                      const Tracks* tracks) const
+{
+    if (keyFrameMasks.empty())
+        CV_Error(Error::StsBadArg, "CloneBuilder::build: no object masks");
+    if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
+        CV_Error(Error::StsBadSize, "CloneBuilder::build: the reconstruction has no image size");
+    if (tracks && !rec.points.empty() && tracks->points() != rec.points.rows)
+        CV_Error(Error::StsBadSize, cv::format("CloneBuilder::build: tracks have %d columns, the "
+                 "reconstruction %d points", tracks->points(), rec.points.rows));
+    if (!rec.points.empty() && (rec.points.cols != 3 || rec.points.type() != CV_64FC1))
+        CV_Error(Error::StsBadArg, "CloneBuilder::build: reconstruction points must be Nx3 CV_64F");
+    ObjectMasks bins;
+    for (const auto& o : keyFrameMasks)
+    {
+        if (o.second.empty())
+            CV_Error(Error::StsBadArg, "CloneBuilder::build: object '" + o.first +
+                     "' has no key frame");
+        for (const auto& fm : o.second)
+        {
+            checkMask(fm.second, rec, o.first, fm.first);
+            bins[o.first][fm.first] = fm.second > 127;
+        }
+    }
+    Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
+    set->patchRule = params_.patches.rule;
+    for (const auto& o : bins)
+        for (const auto& m : o.second)
+            set->add(o.first).masks[m.first] = m.second.clone();
+
+    PassContext ctx(rec, *set, params_);
+    ctx.keyFrameMasks = &bins;
+    ctx.tracks = tracks;
+    runPass("box", passBox, *set, ctx);                 // 1. Steps 1-3: points, box, grid
+    runPass("carve", passCarve, *set, ctx);             // 2. Step 4: silhouette carving
+    runPass("grid growth", passGridGrowth, *set, ctx);  // 3. the hull beyond Step 3's box
+    if (tracks && params_.freeSpace.minViews > 0)
+        runPass("free space", passFreeSpace, *set, ctx);  // 4. what the tracks show empty
+    if (params_.unobserved.enabled)
+    {
+        const ObservedSurfaces observed = observeSurfaces(*set, rec, params_.unobserved);
+        ctx.observed = &observed;
+        runPass("unobserved", passUnobserved, *set, ctx);  // 5. what no frame sees
+        ctx.observed = nullptr;
+    }
+    runPass("patches", passPatches, *set, ctx);         // 6. Step 5: patch voxels
+    return set;
+}
+
+void CloneBuilderImpl::addKeyFrame(CloneSet& clones, const Reconstruction& rec,
+                                   const String& object, int frame, InputArray mask) const
+{
+    CloneSetImpl& set = cloneSetOf(clones, "addKeyFrame");
+    ObjectClone& obj = set.get(object);
+    Mat m = mask.getMat();
+    checkMask(m, rec, object, frame);
+    obj.masks[frame] = m > 127;
+    PassContext ctx(rec, set, params_);
+    ctx.carveFrame = frame;
+    passCarve(obj, ctx);    // Step 4 with the new key frame
+    passPatches(obj, ctx);  // Step 5
+}
+
+int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
+                               InputArrayOfArrays framesArr) const
+{
+    CloneSetImpl& set = cloneSetOf(clones, "CloneBuilder::refine");
+    if (rec.cameras.empty())
+        CV_Error(Error::StsBadArg, "CloneBuilder::refine: the reconstruction has no camera");
+    if (framesArr.empty())
+        CV_Error(Error::StsBadArg, "CloneBuilder::refine: no frames");
+    if (!framesArr.isMatVector() && !framesArr.isUMatVector())
+        CV_Error(Error::StsBadArg, "CloneBuilder::refine: frames must be a vector of images");
+    const int nframes = (int)framesArr.total();
+    std::vector<Mat> frames(nframes);
+    for (const Camera& cam : rec.cameras)
+    {
+        const int f = cam.frame;
+        if (f < 0 || f >= nframes)
+            CV_Error(Error::StsBadArg, cv::format("CloneBuilder::refine: the reconstruction has a "
+                     "camera for frame %d but %d frames are given", f, nframes));
+        Mat m = framesArr.getMat(f);
+        if (m.empty())
+            CV_Error(Error::StsBadArg, cv::format("CloneBuilder::refine: frame %d is empty", f));
+        if (m.size() != rec.imageSize)
+            CV_Error(Error::StsBadSize, cv::format("CloneBuilder::refine: frame %d is %dx%d, the "
+                     "reconstruction's image size %dx%d", f, m.cols, m.rows,
+                     rec.imageSize.width, rec.imageSize.height));
+        if (m.type() == CV_8UC1)
+            cvtColor(m, frames[f], COLOR_GRAY2BGR);
+        else if (m.type() == CV_8UC3)
+            frames[f] = m;
+        else
+            CV_Error(Error::StsUnsupportedFormat, cv::format("CloneBuilder::refine: frame %d "
+                     "must be CV_8UC3 or CV_8UC1", f));
+    }
+    for (const auto& o : set.objects())
+        for (const auto& m : o.second.masks)
+            if (m.second.size() != rec.imageSize)
+                CV_Error(Error::StsBadSize, cv::format("CloneBuilder::refine: object '%s': key "
+                         "frame %d's silhouette differs from the reconstruction's image size",
+                         o.first.c_str(), m.first));
+            else if (rec.findCamera(m.first) < 0)
+                CV_Error(Error::StsBadArg, cv::format("CloneBuilder::refine: object '%s': key "
+                         "frame %d has no camera", o.first.c_str(), m.first));
+
+    PassContext ctx(rec, set, params_);
+    std::map<String, int64> carved;
+    for (int round = 0; round < params_.photo.rounds; round++)
+    {
+        // Each round sees the other clones as the last round left them.
+        const PhotoViews views = preparePhotoViews(set, rec, frames, params_.photo);
+        ctx.photo = &views;
+        int64 roundCarved = 0;
+        for (const String& name : set.objectNames())
+        {
+            const int64 n = passPhoto(set.get(name), ctx);
+            carved[name] += n;
+            roundCarved += n;
+            CV_LOG_DEBUG(NULL, cv::format("augocc: photo-consistency round %d: object '%s': %lld "
+                         "voxels carved", round, name.c_str(), (long long)n));
+        }
+        ctx.photo = nullptr;
+        if (roundCarved == 0)
+            break;
+    }
+    int64 total = 0;
+    for (const auto& c : carved)
+    {
+        total += c.second;
+        if (c.second > 0)
+            passPatches(set.get(c.first), ctx);  // Step 5 again where the clone changed
+    }
+    return total;
+}
+
+} // namespace
+
+Ptr<CloneBuilder> CloneBuilder::create(const Params& params)
+{
+    return makePtr<CloneBuilderImpl>(params);
+}
+
+Ptr<CloneBuilder> CloneBuilder::create()
+{
+    return makePtr<CloneBuilderImpl>(Params());
+}
+
+} // namespace augocc
+} // namespace cv

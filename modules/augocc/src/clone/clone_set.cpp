@@ -1,0 +1,383 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// CloneSet: rendering (matte + depth), file I/O, PLY export and the mattes folder.
+
+#include "precomp.hpp"
+#include "clone/clone_set.hpp"
+#include "clone/clone_codec.hpp"
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+namespace cv {
+namespace augocc {
+
+CloneSet::~CloneSet() {}
+
+namespace detail {
+
+namespace fsys = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------
+// CloneSetImpl
+
+const ObjectClone& CloneSetImpl::get(const String& object) const
+{
+    auto it = objects_.find(object);
+    if (it == objects_.end())
+        CV_Error(Error::StsObjectNotFound, "clones: no object '" + object + "'");
+    return it->second;
+}
+
+ObjectClone& CloneSetImpl::get(const String& object)
+{
+    auto it = objects_.find(object);
+    if (it == objects_.end())
+        CV_Error(Error::StsObjectNotFound, "clones: no object '" + object + "'");
+    return it->second;
+}
+
+ObjectClone& CloneSetImpl::add(const String& object)
+{
+    ObjectClone& o = objects_[object];
+    o.name = object;
+    return o;
+}
+
+std::vector<String> CloneSetImpl::objectNames() const
+{
+    std::vector<String> names;
+    for (const auto& o : objects_)
+        names.push_back(o.first);
+    return names;
+}
+
+std::vector<int> CloneSetImpl::keyFrames(const String& object) const
+{
+    std::vector<int> k;
+    for (const auto& m : get(object).masks)
+        k.push_back(m.first);
+    return k;
+}
+
+std::vector<int> CloneSetImpl::patchFrames(const String& object, int frame) const
+{
+    const std::vector<int> keys = keyFrames(object);
+    if (keys.empty())
+        return keys;
+    auto it = std::lower_bound(keys.begin(), keys.end(), frame);
+    if (it != keys.end() && *it == frame)
+        return std::vector<int>(1, frame);
+    if (it == keys.begin())
+        return std::vector<int>(1, keys.front());
+    if (it == keys.end())
+        return std::vector<int>(1, keys.back());
+    const int before = *(it - 1), after = *it;
+    if (patchRule == CloneBuilder::PATCH_BRACKETING)
+        return std::vector<int>{before, after};
+    return std::vector<int>(1, frame - before <= after - frame ? before : after);
+}
+
+int CloneSetImpl::voxelCount(const String& object) const
+{
+    return (int)get(object).grid.count();
+}
+
+int CloneSetImpl::patchVoxelCount(const String& object, int keyFrame) const
+{
+    const ObjectClone& o = get(object);
+    auto it = o.patches.find(keyFrame);
+    return it == o.patches.end() ? 0 : (int)it->second.size();
+}
+
+Vec3i CloneSetImpl::gridSize(const String& object) const
+{
+    return get(object).grid.dims;
+}
+
+double CloneSetImpl::voxelSize(const String& object) const
+{
+    return get(object).grid.h;
+}
+
+void CloneSetImpl::gridPose(const String& object, Matx33d& Rbox, Vec3d& origin) const
+{
+    const ObjectClone& o = get(object);
+    Rbox = o.grid.Rbox;
+    origin = o.grid.origin;
+}
+
+void CloneSetImpl::render(const String& object, int frame, const Camera& camera, Size imageSize,
+                          OutputArray matte, OutputArray depth) const
+{
+    const ObjectClone& o = get(object);
+    if (imageSize.width <= 0 || imageSize.height <= 0)
+        CV_Error(Error::StsBadSize, cv::format("clones: render: bad image size %dx%d",
+                                               imageSize.width, imageSize.height));
+    const VoxelProjector proj = o.grid.projector(camera, imageSize);
+    std::vector<VoxelList> lists(1);
+    lists[0].ijk = o.surface.ijk.data();
+    lists[0].faces = o.surface.faces.data();
+    lists[0].n = o.surface.size();
+    lists[0].frontOnly = true;
+    for (int kf : patchFrames(object, frame))
+    {
+        auto it = o.patches.find(kf);
+        if (it == o.patches.end() || it->second.empty())
+            continue;
+        VoxelList l;
+        l.ijk = it->second.data();
+        l.n = it->second.size();
+        lists.push_back(l);
+    }
+    // Rendered straight into the caller's depth map; the matte only over the grid's bounds.
+    Mat zmin;
+    if (depth.needed())
+    {
+        depth.create(imageSize, CV_32F);
+        zmin = depth.getMat();
+    }
+    renderDepth(o.grid, proj, lists, zmin);
+    if (matte.needed())
+    {
+        matte.create(imageSize, CV_8U);
+        Mat m = matte.getMat();
+        const Rect roi = o.grid.imageBounds(proj);
+        m.setTo(Scalar(0));
+        if (!roi.empty())
+            compare(zmin(roi), std::numeric_limits<float>::infinity(), m(roi), CMP_LT);
+    }
+}
+
+void CloneSetImpl::save(const String& path) const
+{
+    writeAtomically(path, [&](const String& tmp) {
+        FileStorage fs(tmp, FileStorage::WRITE);
+        if (!fs.isOpened())
+            CV_Error(Error::StsError, path + ": cannot open for writing");
+        fs << "format" << "augocc_clones";
+        fs << "version" << 1;
+        fs << "patch_rule" << (patchRule == CloneBuilder::PATCH_BRACKETING ? "bracketing"
+                                                                              : "nearest");
+        fs << "objects" << "[";
+        for (const auto& it : objects_)
+        {
+            const ObjectClone& o = it.second;
+            fs << "{";
+            fs << "name" << o.name;
+            fs << "dims" << Mat(o.grid.dims).reshape(1, 1);
+            fs << "R_box" << Mat(o.grid.Rbox);
+            fs << "origin" << Mat(o.grid.origin);
+            fs << "voxel_size" << o.grid.h;
+            fs << "centre" << Mat(o.centre);
+            writeBlob(fs, "voxels", encodeGrid(o.grid.data, o.grid.dims[0],
+                                               o.grid.dims[1] * o.grid.dims[2]));
+            fs << "key_frames" << "[";
+            for (const auto& m : o.masks)
+            {
+                fs << "{";
+                fs << "frame" << m.first;
+                std::vector<uchar> png;
+                cv::imencode(".png", m.second, png);
+                writeBlob(fs, "mask_png", png);
+                std::vector<uchar> pv;
+                auto p = o.patches.find(m.first);
+                if (p != o.patches.end())
+                {
+                    putVarint(pv, p->second.size());
+                    uint32_t last = 0;
+                    for (uint32_t v : p->second)
+                    {
+                        putVarint(pv, v - last);  // sorted: deltas are small
+                        last = v;
+                    }
+                }
+                else
+                    putVarint(pv, 0);
+                writeBlob(fs, "patches", pv);
+                fs << "}";
+            }
+            fs << "]";
+            fs << "}";
+        }
+        fs << "]";
+        fs.release();
+    });
+}
+
+void CloneSetImpl::exportPly(const String& dir) const
+{
+    std::error_code ec;
+    fsys::create_directories(dir, ec);
+    if (!fsys::is_directory(dir))
+        CV_Error(Error::StsError, dir + ": cannot create folder");
+    for (const auto& it : objects_)
+    {
+        const ObjectClone& o = it.second;
+        writeMeshPly((fsys::path(dir) / (o.name + "_clone.ply")).string(),
+                     o.grid.surfaceMesh(o.surface));
+        for (const auto& p : o.patches)
+            writeMeshPly((fsys::path(dir) / cv::format("%s_patches_%04d.ply", o.name.c_str(),
+                                                       p.first)).string(),
+                         o.grid.cubesMesh(p.second));
+    }
+}
+
+} // namespace detail
+
+Ptr<CloneSet> CloneSet::load(const String& path)
+{
+    using namespace detail;
+    FileStorage fs;
+    try
+    {
+        fs.open(path, FileStorage::READ);
+    }
+    catch (const cv::Exception& e)
+    {
+        CV_Error(Error::StsParseError, path + ": cannot parse: " + e.msg);
+    }
+    if (!fs.isOpened())
+        CV_Error(Error::StsObjectNotFound, path + ": cannot open clones file");
+    if ((String)fs["format"] != "augocc_clones")
+        CV_Error(Error::StsParseError, path + ": key 'format' is not 'augocc_clones'");
+    Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
+    const String rule = (String)fs["patch_rule"];
+    set->patchRule = rule == "bracketing" ? CloneBuilder::PATCH_BRACKETING
+                                          : CloneBuilder::PATCH_NEAREST;
+    FileNode objs = fs["objects"];
+    if (!objs.isSeq())
+        CV_Error(Error::StsParseError, path + ": key 'objects' must be a sequence");
+    for (FileNodeIterator it = objs.begin(); it != objs.end(); ++it)
+    {
+        FileNode n = *it;
+        ObjectClone o;
+        n["name"] >> o.name;
+        const String where = path + ": object '" + o.name + "'";
+        if (o.name.empty())
+            CV_Error(Error::StsParseError, path + ": an object has no 'name'");
+        Mat dims, R, origin, centre;
+        n["dims"] >> dims;
+        n["R_box"] >> R;
+        n["origin"] >> origin;
+        n["centre"] >> centre;
+        double h = 0;
+        n["voxel_size"] >> h;
+        if (dims.total() != 3 || R.rows != 3 || R.cols != 3 || origin.total() != 3 ||
+            centre.total() != 3 || !(h > 0))
+            CV_Error(Error::StsParseError, where + ": missing or malformed dims, R_box, origin, "
+                     "centre or voxel_size");
+        dims.convertTo(dims, CV_32S);
+        R.convertTo(R, CV_64F);
+        origin.convertTo(origin, CV_64F);
+        centre.convertTo(centre, CV_64F);
+        const Vec3i d(dims.ptr<int>()[0], dims.ptr<int>()[1], dims.ptr<int>()[2]);
+        if (d[0] <= 0 || d[1] <= 0 || d[2] <= 0 || std::max(d[0], std::max(d[1], d[2])) > kMaxGridDim)
+            CV_Error(Error::StsParseError, where + ": bad grid dims");
+        o.grid.dims = d;
+        o.grid.Rbox = Matx33d((double*)R.ptr<double>());
+        o.grid.origin = Vec3d(origin.ptr<double>());
+        o.grid.h = h;
+        o.centre = Vec3d(centre.ptr<double>());
+        decodeGrid(readBlob(n["voxels"], where + " voxels"), d[0], d[1] * d[2], o.grid.data,
+                   where + " voxels");
+        FileNode kfs = n["key_frames"];
+        for (FileNodeIterator k = kfs.begin(); k != kfs.end(); ++k)
+        {
+            int frame = -1;
+            (*k)["frame"] >> frame;
+            const String kw = where + cv::format(" key frame %d", frame);
+            const std::vector<uchar> png = readBlob((*k)["mask_png"], kw + " mask_png");
+            Mat mask = png.empty() ? Mat() : cv::imdecode(png, IMREAD_GRAYSCALE);
+            if (frame < 0 || mask.empty())
+                CV_Error(Error::StsParseError, kw + ": no frame index or no readable mask");
+            o.masks[frame] = mask > 127;
+            const std::vector<uchar> pv = readBlob((*k)["patches"], kw + " patches");
+            size_t pos = 0;
+            const uint64_t count = getVarint(pv, pos, kw + " patches");
+            if (count > (uint64_t)o.grid.total())
+                CV_Error(Error::StsParseError, kw + ": corrupt patches");
+            std::vector<uint32_t> p((size_t)count);
+            uint64_t last = 0;
+            for (size_t q = 0; q < p.size(); q++)
+            {
+                last += getVarint(pv, pos, kw + " patches");
+                int i, j, kk;
+                unpackVoxel((uint32_t)last, i, j, kk);
+                if (last > 0xffffffffULL || !o.grid.inside(i, j, kk))
+                    CV_Error(Error::StsParseError, kw + ": a patch voxel is off the grid");
+                p[q] = (uint32_t)last;
+            }
+            o.patches[frame] = p;
+        }
+        o.surface = o.grid.surface();
+        set->add(o.name) = std::move(o);
+    }
+    return set;
+}
+
+void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks& mattes,
+                  std::map<String, std::map<int, Mat> >* depth)
+{
+    const std::vector<String> names = clones.objectNames();
+    const int nc = (int)rec.cameras.size();
+    if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
+        CV_Error(Error::StsBadSize, "renderMattes: reconstruction has no image size");
+    std::vector<std::vector<Mat> > m(names.size(), std::vector<Mat>(nc)), d = m;
+    parallel_for_(Range(0, nc), [&](const Range& r) {
+        for (int c = r.start; c < r.end; c++)
+            for (size_t o = 0; o < names.size(); o++)
+            {
+                if (depth)
+                    clones.render(names[o], rec.cameras[c].frame, rec.cameras[c], rec.imageSize,
+                                  m[o][c], d[o][c]);
+                else
+                    clones.render(names[o], rec.cameras[c].frame, rec.cameras[c], rec.imageSize,
+                                  m[o][c]);
+            }
+    });
+    mattes.clear();
+    if (depth)
+        depth->clear();
+    for (size_t o = 0; o < names.size(); o++)
+        for (int c = 0; c < nc; c++)
+        {
+            mattes[names[o]][rec.cameras[c].frame] = m[o][c];
+            if (depth)
+                (*depth)[names[o]][rec.cameras[c].frame] = d[o][c];
+        }
+}
+
+void writeMattes(const String& dir, const CloneSet& clones, const Reconstruction& rec,
+                 const String& depthDir)
+{
+    ObjectMasks mattes;
+    std::map<String, std::map<int, Mat> > depth;
+    renderMattes(clones, rec, mattes, depthDir.empty() ? nullptr : &depth);
+    if (!depthDir.empty())
+    {
+        namespace fsys = std::filesystem;
+        fsys::path target(depthDir);
+        if (target.has_parent_path())
+            fsys::create_directories(target.parent_path());
+        writeAtomically(depthDir, [&](const String& tmp) {
+            fsys::create_directories(tmp);
+            for (const auto& o : depth)
+            {
+                const fsys::path od = fsys::path(tmp) / o.first;
+                fsys::create_directories(od);
+                for (const auto& f : o.second)
+                {
+                    const String file = (od / cv::format("%04d.tiff", f.first)).string();
+                    if (!cv::imwrite(file, f.second))
+                        CV_Error(Error::StsError, depthDir + ": cannot write " + file);
+                }
+            }
+        });
+    }
+    writeMasks(dir, mattes);
+}
+
+} // namespace augocc
+} // namespace cv

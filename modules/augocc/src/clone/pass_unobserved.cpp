@@ -1,0 +1,173 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// Beyond the paper, for what no frame can see. A part of the visual hull that is behind another
+// object or behind the object's own near side in every frame of the video (the lower back of a
+// tower behind a building in the first key frames and behind its own shaft in the last) is not
+// constrained by any silhouette: the hull keeps it at its largest, a wedge along the lines of
+// sight of the key frames that see the part. Since no frame sees it, it changes no composite of
+// the video; but it is conjecture, and in the object's matte as if alone (and in any view beyond
+// the video) it shows as a bulge. The prior taken here is support along the vertical: the clone's
+// voxels are cut into vertical runs (the grid axis nearest the vertical the cameras give), and a
+// run none of whose voxels any frame shows (first along its line of sight among every clone's
+// voxels, in UnobservedParams::views evenly spaced frames and every key frame) goes. The inside
+// of a building under its seen roof, the hidden back of a shaft under its seen cap, stay (their
+// run holds a seen voxel); a wedge with air above it and the ground below goes.
+
+#include "precomp.hpp"
+#include "clone/passes.hpp"
+#include "clone/key_frame_coverage.hpp"
+
+#include <set>
+
+namespace cv {
+namespace augocc {
+namespace detail {
+
+ObservedSurfaces observeSurfaces(const CloneSetImpl& clones, const Reconstruction& rec,
+                                 const CloneBuilder::UnobservedParams& params)
+{
+    std::vector<const Camera*> cams = evenlySpacedCameras(rec, params.views);
+    std::set<int> have;
+    for (const Camera* c : cams)
+        have.insert(c->frame);
+    for (const auto& o : clones.objects())
+        for (const auto& m : o.second.masks)
+            if (!have.count(m.first))
+            {
+                have.insert(m.first);
+                cams.push_back(&rec.camera(m.first));
+            }
+    std::vector<String> names;
+    for (const auto& o : clones.objects())
+        names.push_back(o.first);
+    // Per frame and object, the surface voxels seen (frames in parallel, merged in order).
+    std::vector<std::vector<std::vector<uint32_t> > > seenIn(
+        cams.size(), std::vector<std::vector<uint32_t> >(names.size()));
+    const Size size = rec.imageSize;
+    parallel_for_(Range(0, (int)cams.size()), [&](const Range& r) {
+        for (int ci = r.start; ci < r.end; ci++)
+        {
+            const Camera& cam = *cams[ci];
+            Mat zbuf(size, CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+            std::vector<VoxelProjector> projs(names.size());
+            for (size_t n = 0; n < names.size(); n++)
+            {
+                const ObjectClone& obj = clones.get(names[n]);
+                if (obj.grid.empty())
+                    continue;
+                projs[n] = obj.grid.projector(cam, size);
+                splatVoxels(projs[n], obj.surface.ijk.data(), obj.surface.faces.data(),
+                            obj.surface.size(), true, zbuf, nullptr, Point());
+            }
+            for (size_t n = 0; n < names.size(); n++)
+            {
+                const ObjectClone& obj = clones.get(names[n]);
+                if (obj.grid.empty())
+                    continue;
+                const double tol = params.depthTolVoxels * obj.grid.h;
+                for (size_t q = 0; q < obj.surface.size(); q++)
+                {
+                    int i, j, k;
+                    unpackVoxel(obj.surface.ijk[q], i, j, k);
+                    Point px;
+                    if (!projs[n].centrePixel(i, j, k, px) || px.x < 0 || px.y < 0 ||
+                        px.x >= size.width || px.y >= size.height)
+                        continue;
+                    const double z = projs[n].Z.dot(Vec3d(i, j, k)) + projs[n].z0;
+                    if (z <= zbuf.at<float>(px) + tol)
+                        seenIn[ci][n].push_back((uint32_t)q);
+                }
+            }
+        }
+    });
+    ObservedSurfaces out;
+    for (size_t n = 0; n < names.size(); n++)
+    {
+        std::vector<uint32_t>& s = out.seen[names[n]];
+        for (size_t ci = 0; ci < cams.size(); ci++)
+            s.insert(s.end(), seenIn[ci][n].begin(), seenIn[ci][n].end());
+    }
+    return out;
+}
+
+int64 passUnobserved(ObjectClone& obj, const PassContext& ctx)
+{
+    const CloneBuilder::UnobservedParams& p = ctx.params.unobserved;
+    const Vec3d up = estimateVertical(ctx.rec);
+    VoxelGrid& g = obj.grid;
+    int64 count = 0;
+    if (g.empty())
+        return 0;
+    int axis = 0;
+    double best = 0;
+    for (int a = 0; a < 3; a++)
+    {
+        const double c = std::abs(up.dot(Vec3d(g.Rbox(0, a), g.Rbox(1, a), g.Rbox(2, a))));
+        if (c > best)
+        {
+            best = c;
+            axis = a;
+        }
+    }
+    if (best < std::cos(p.maxTiltDeg * CV_PI / 180))
+        return 0;
+    std::vector<uchar> sn(g.data.size(), 0);
+    for (uint32_t q : ctx.observed->seen.at(obj.name))
+    {
+        int i, j, k;
+        unpackVoxel(obj.surface.ijk[q], i, j, k);
+        sn[g.index(i, j, k)] = 1;
+    }
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    std::vector<int64> perSlice(g.dims[v], 0);
+    parallel_for_(Range(0, g.dims[v]), [&](const Range& r) {
+        for (int b = r.start; b < r.end; b++)
+            for (int a = 0; a < g.dims[u]; a++)
+            {
+                int idx[3];
+                idx[u] = a;
+                idx[v] = b;
+                int start = -1;
+                bool any = false;
+                for (int t = 0; t <= g.dims[axis]; t++)
+                {
+                    bool in = false;
+                    size_t id = 0;
+                    if (t < g.dims[axis])
+                    {
+                        idx[axis] = t;
+                        id = g.index(idx[0], idx[1], idx[2]);
+                        in = g.data[id] != 0;
+                    }
+                    if (in)
+                    {
+                        if (start < 0)
+                        {
+                            start = t;
+                            any = false;
+                        }
+                        any = any || sn[id];
+                        continue;
+                    }
+                    if (start >= 0 && !any)
+                        for (int w = start; w < t; w++)
+                        {
+                            idx[axis] = w;
+                            g.data[g.index(idx[0], idx[1], idx[2])] = 0;
+                            perSlice[b]++;
+                        }
+                    start = -1;
+                }
+            }
+    });
+    for (int64 c : perSlice)
+        count += c;
+    if (count > 0)
+        obj.surface = g.surface();
+    return count;
+}
+
+} // namespace detail
+} // namespace augocc
+} // namespace cv
