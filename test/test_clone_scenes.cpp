@@ -224,7 +224,7 @@ SynthFigures measureSynth(const CloneSet& clones, const SyntheticScene& s, const
 }
 
 DepthFigures measureDepth(const CloneSet& clones, const SyntheticScene& s, const String& name,
-                          const String& debugPng = String())
+                          const String& debugPng)
 {
     DepthFigures fig;
     int64 n = 0;

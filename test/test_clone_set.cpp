@@ -6,6 +6,7 @@
 #include "test_clone_scenes.hpp"
 
 #include <filesystem>
+#include <fstream>
 
 namespace opencv_test {
 namespace {
