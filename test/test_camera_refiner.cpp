@@ -293,7 +293,7 @@ TEST(Augocc_SfmSynth, partial_and_outlier_tracks)
     int nOut = 0, outRejected = 0, nGood = 0, goodKept = 0;
     for (int p = 0; p < scene.tracks.points(); p++)
     {
-        const bool kept = std::isfinite(rec.points.at<double>(p, 0));
+        const bool kept = rec.hasPoint(p);
         if (scene.outlierTrack[p])
         {
             nOut++;
@@ -366,12 +366,12 @@ TEST(Augocc_SfmSynth, perspective_rejected_tracks_rescued)
     std::vector<double> err, errR;
     for (int p = 0; p < scene.tracks.points(); p++)
     {
-        const double* X = rec.points.ptr<double>(p);
-        if (!std::isfinite(X[0]) || scene.outlierTrack[p])
+        if (!rec.hasPoint(p) || scene.outlierTrack[p])
         {
-            outRescued += std::isfinite(X[0]) && !inliers.at<uchar>(p);
+            outRescued += rec.hasPoint(p) && !inliers.at<uchar>(p);
             continue;
         }
+        const Vec3d X = rec.point(p);
         const Vec4d Y = M * Vec4d(X[0], X[1], X[2], 1);
         const double* G = scene.groundTruth.points.ptr<double>(p);
         const double e = cv::norm(Vec3d(Y[0], Y[1], Y[2]) - Vec3d(G[0], G[1], G[2]));

@@ -33,7 +33,7 @@ TEST(Augocc_SfmRealData, cmu_hotel_klt)
     std::vector<const Camera*> cams;
     for (int p = 0; p < tracks.points(); p++)
     {
-        if (std::isfinite(all.points.at<double>(p, 0)))
+        if (all.hasPoint(p))
             continue;
         std::vector<const Camera*> cs;
         std::vector<Point2d> obs;

@@ -380,13 +380,9 @@ GroundFrame estimateGround(const Reconstruction& rec)
     GroundFrame g;
     // Ground plane from the points.
     std::vector<Vec3d> pts;
-    if (!rec.points.empty())
-        for (int i = 0; i < rec.points.rows; i++)
-        {
-            const double* p = rec.points.ptr<double>(i);
-            if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
-                pts.push_back(Vec3d(p[0], p[1], p[2]));
-        }
+    for (int i = 0; i < rec.points.rows; i++)
+        if (rec.hasPoint(i))
+            pts.push_back(rec.point(i));
     double height = 0;
     bool fromPlane = false;
     if (pts.size() >= 10)
