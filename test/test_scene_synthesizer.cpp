@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "test_precomp.hpp"
+#include "stats.hpp"
 
 #include <filesystem>
 #include <map>
@@ -347,8 +348,7 @@ TEST_P(Augocc_SceneSynthesizer_P, textures_trackable)
         errors.push_back(cv::norm(Point2d(p1[i]) - expected));
     }
     ASSERT_GE((int)errors.size(), kMinKltCorners);
-    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-    const double median = errors[errors.size() / 2];
+    const double median = augocc::detail::median(errors);
     std::cout << "[ MEASURE  ] " << cameraModelName(model) << ": " << p0.size()
               << " corners, KLT frame 0 -> 1 median error " << median << " px" << std::endl;
     EXPECT_LE(median, kMaxKltMedianErrPx);

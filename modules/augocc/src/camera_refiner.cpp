@@ -8,6 +8,7 @@
 #include "precomp.hpp"
 #include "sfm_ceres.hpp"
 #include "sfm_detail.hpp"
+#include "stats.hpp"
 
 #include <deque>
 #include <Eigen/Geometry>
@@ -42,8 +43,8 @@ ReprojectionStats computeReprojectionStats(const Reconstruction& rec, const Trac
     if (e.empty())
         return st;
     st.rms = std::sqrt(s2 / e.size());
+    st.median = detail::median(e);
     std::sort(e.begin(), e.end());
-    st.median = e[e.size() / 2];
     st.p95 = e[std::min(e.size() - 1, (size_t)(0.95 * e.size()))];
     return st;
 }

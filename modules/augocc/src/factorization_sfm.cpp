@@ -8,6 +8,7 @@
 
 #include "precomp.hpp"
 #include "sfm_detail.hpp"
+#include "stats.hpp"
 
 #include <numeric>
 #include <Eigen/Dense>
@@ -941,10 +942,8 @@ bool FactorizationSfMImpl::reconstructIncremental(SfmData& d, Reconstruction& ou
             const double ssr = trackSsr(d, tr[c], m, Vec3d(x[0], x[1], x[2]), n);
             res[c] = std::sqrt(ssr / std::max(1, n));
         }
-        std::vector<double> sorted = res;
-        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
         const double thr = std::max(params_.outlierThreshold,
-                                    params_.outlierSigmas * sorted[sorted.size() / 2]);
+                                    params_.outlierSigmas * detail::median(res));
         std::vector<int> kept;
         for (size_t c = 0; c < tr.size(); c++)
             if (res[c] <= thr)
@@ -1148,8 +1147,7 @@ bool FactorizationSfMImpl::reconstruct(const Tracks& tracks, Reconstruction& out
                 r.push_back(resid[p]);
         if (r.empty())
             break;
-        std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-        const double med = r[r.size() / 2];
+        const double med = detail::median(r);
         const double thr = std::max(params_.outlierThreshold, params_.outlierSigmas * med);
         std::vector<uchar> next(P, 0);
         int changed = 0, nNext = 0;

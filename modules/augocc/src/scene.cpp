@@ -5,6 +5,7 @@
 // placement helpers that put objects relative to the clones of what the user sees.
 
 #include "precomp.hpp"
+#include "stats.hpp"
 
 #include <filesystem>
 #include <set>
@@ -392,7 +393,7 @@ GroundFrame estimateGround(const Reconstruction& rec)
             h[i] = up.dot(pts[i]);
         std::vector<double> hs = h;
         std::sort(hs.begin(), hs.end());
-        const double hMedian = hs[hs.size() / 2];
+        const double hMedian = detail::median(h);
         height = hs[(size_t)(0.02 * (hs.size() - 1))];
         // Spread of the scene along up: the inlier band is 1% of it.
         const double extent = std::max(hs.back() - hs.front(), 1e-12);
