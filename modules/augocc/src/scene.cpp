@@ -5,6 +5,7 @@
 // placement helpers that put objects relative to the clones of what the user sees.
 
 #include "precomp.hpp"
+#include "io_internal.hpp"
 #include "stats.hpp"
 
 #include <filesystem>
@@ -135,19 +136,7 @@ std::vector<Mesh> proceduralShape(const String& shape)
 
 VirtualScene readScene(const String& path)
 {
-    if (!fs::is_regular_file(path))
-        CV_Error(Error::StsObjectNotFound, path + ": scene file not found");
-    FileStorage fsIn;
-    try
-    {
-        fsIn.open(path, FileStorage::READ);
-    }
-    catch (const cv::Exception& e)
-    {
-        CV_Error(Error::StsParseError, path + ": cannot parse scene file: " + e.err);
-    }
-    if (!fsIn.isOpened())
-        CV_Error(Error::StsParseError, path + ": cannot parse scene file");
+    const FileStorage fsIn = detail::openFileStorageForRead(path, "scene file");
     const FileNode root = fsIn.root();
     const char* const rootKeys[] = {"objects"};
     checkKeys(root, rootKeys, 1, path, "top level");
