@@ -6,6 +6,7 @@
 // started from the affine solution; recoverCameras(), the `augocc sfm` pipeline.
 
 #include "precomp.hpp"
+#include "ground_plane.hpp"
 #include "sfm_ceres.hpp"
 #include "sfm_detail.hpp"
 #include "stats.hpp"
@@ -547,31 +548,11 @@ double frontOfDominantPlane(const Reconstruction& rec)
     for (const Vec3d& p : P)
         r2 += (p - m).dot(p - m);
     const double band = kPlaneBand * std::sqrt(r2 / N);
-    RNG rng(0x2545F491);
-    int best = 0;
-    Vec3d bestN;
-    double bestD = 0;
-    for (int trial = 0; trial < kPlaneTrials; trial++)
-    {
-        const Vec3d a = P[rng.uniform(0, N)], b = P[rng.uniform(0, N)], c = P[rng.uniform(0, N)];
-        Vec3d n = (b - a).cross(c - a);
-        const double nn = cv::norm(n);
-        if (!(nn > 0))
-            continue;
-        n *= 1.0 / nn;
-        const double d = n.dot(a);
-        int count = 0;
-        for (const Vec3d& p : P)
-            count += std::abs(n.dot(p) - d) < band;
-        if (count > best)
-        {
-            best = count;
-            bestN = n;
-            bestD = d;
-        }
-    }
-    if (best < 3)
+    const detail::PlaneFit plane = detail::ransacPlane(P, P, band, kPlaneTrials, 0x2545F491);
+    if (plane.inliers < 3)
         return -1;
+    Vec3d bestN = plane.normal;
+    double bestD = plane.offset;
     if (bestN[2] > 0)   // normal towards the camera
     {
         bestN = -bestN;
