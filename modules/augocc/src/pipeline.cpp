@@ -143,43 +143,6 @@ Mat encodeDepth(const Mat& z, DepthEncoding& enc)
 
 } // namespace
 
-void parseFrameRange(const String& text, int& firstFrame, int& endFrame)
-{
-    auto parseInt = [&](const String& s, int& v) {
-        if (s.empty())
-            return false;
-        size_t pos = 0;
-        try
-        {
-            v = std::stoi(s, &pos);
-        }
-        catch (const std::exception&)
-        {
-            return false;
-        }
-        return pos == s.size();
-    };
-    const size_t colon = text.find(':');
-    bool ok;
-    if (colon == String::npos)
-    {
-        ok = parseInt(text, firstFrame);
-        endFrame = firstFrame + 1;
-    }
-    else
-    {
-        ok = parseInt(text.substr(0, colon), firstFrame);
-        const String rest = text.substr(colon + 1);
-        if (rest.empty())
-            endFrame = -1;
-        else
-            ok = ok && parseInt(rest, endFrame);
-    }
-    if (!ok || firstFrame < 0 || (endFrame != -1 && endFrame <= firstFrame))
-        CV_Error(Error::StsBadArg, "frame range '" + text + "': expected a:b with 0 <= a < b, "
-                 "a: or a");
-}
-
 int compositeSequence(const String& input, const Reconstruction& rec, const CloneSet& clones,
                       const std::vector<Mesh>& virtualObjects, const String& output,
                       const CompositeOptions& options)

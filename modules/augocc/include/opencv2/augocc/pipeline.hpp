@@ -71,10 +71,6 @@ CV_EXPORTS int compositeSequence(const String& input, const Reconstruction& rec,
                                  const String& output,
                                  const CompositeOptions& options = CompositeOptions());
 
-/** @brief Parses a frame range `a:b` (frames a..b-1), `a:` (a to the end) or `a` (one frame).
-Throws StsBadArg on anything else. @param endFrame -1 for "to the end". */
-CV_EXPORTS void parseFrameRange(const String& text, int& firstFrame, int& endFrame);
-
 //! Options of runPipeline() (`augocc run`).
 struct CV_EXPORTS RunOptions
 {
