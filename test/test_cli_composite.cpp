@@ -239,7 +239,9 @@ TEST_F(Augocc_CliComposite, bad_input_scene_unknown_key)
 TEST_F(Augocc_CliComposite, bad_input_frames_out_of_range)
 {
     const CliData& d = cliData();
-    for (const char* range : {"4:99", "6:", "3:2", "a:b", "-1:3", "2:2"})
+    // Out of the 6 frames, empty, not numbers, negative; a step or a list (composite takes one
+    // range of consecutive frames).
+    for (const char* range : {"4:99", "6:", "3:2", "a:b", "-1:3", "2:2", "1:4:2", "1,3"})
         EXPECT_TRUE(badInputRejected(
             compositeArgs(d.video, d.rec, d.scene, out_ + "/out.mp4", String("--frames ") + range),
             {"frame"}, out_));

@@ -121,7 +121,7 @@ TEST(Augocc_FactorizationSfM, accuracy_outliers)
         {
             nOut++;
             outRejected += inliers.at<uchar>(p) == 0;
-            EXPECT_EQ(inliers.at<uchar>(p) == 0, std::isnan(rec.points.at<double>(p, 0)));
+            EXPECT_EQ(inliers.at<uchar>(p) == 0, !rec.hasPoint(p));
         }
         else
         {

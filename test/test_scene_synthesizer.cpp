@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "test_precomp.hpp"
+#include "stats.hpp"
 
 #include <filesystem>
 #include <map>
@@ -159,7 +160,7 @@ TEST_P(Augocc_SceneSynthesizer_P, ground_truth_tracks)
         const bool out = s.outlierTrack[t] != 0;
         outliers += out;
         const Vec3d X(s.groundTruth.points.ptr<double>(t));
-        EXPECT_EQ(out, !std::isfinite(X[0])) << "track " << t;
+        EXPECT_EQ(out, !s.groundTruth.hasPoint(t)) << "track " << t;
         int first = -1, last = -1, observed = 0;
         for (int f = 0; f < p.frames; f++)
         {
@@ -347,8 +348,7 @@ TEST_P(Augocc_SceneSynthesizer_P, textures_trackable)
         errors.push_back(cv::norm(Point2d(p1[i]) - expected));
     }
     ASSERT_GE((int)errors.size(), kMinKltCorners);
-    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-    const double median = errors[errors.size() / 2];
+    const double median = augocc::detail::median(errors);
     std::cout << "[ MEASURE  ] " << cameraModelName(model) << ": " << p0.size()
               << " corners, KLT frame 0 -> 1 median error " << median << " px" << std::endl;
     EXPECT_LE(median, kMaxKltMedianErrPx);
@@ -588,9 +588,9 @@ TEST(Augocc_SceneSynthesizer, synth_command_end_to_end)
     long n = 0;
     for (int t = 0; t < tracks.points(); t++)
     {
-        const Vec3d X(rec.points.ptr<double>(t));
-        if (!std::isfinite(X[0]))
+        if (!rec.hasPoint(t))
             continue;  // outlier track
+        const Vec3d X = rec.point(t);
         for (int f = 0; f < tracks.frames(); f++)
             if (tracks.observed(f, t))
             {

@@ -6,6 +6,7 @@
 #include "test_precomp.hpp"
 #include "sfm_test_utils.hpp"
 #include "sfm_detail.hpp"
+#include "stats.hpp"
 
 #include <fstream>
 #include <opencv2/calib3d.hpp>
@@ -33,7 +34,7 @@ TEST(Augocc_SfmRealData, cmu_hotel_klt)
     std::vector<const Camera*> cams;
     for (int p = 0; p < tracks.points(); p++)
     {
-        if (std::isfinite(all.points.at<double>(p, 0)))
+        if (all.hasPoint(p))
             continue;
         std::vector<const Camera*> cs;
         std::vector<Point2d> obs;
@@ -137,8 +138,7 @@ TEST(Augocc_SfmRealData, cmu_hotel_frames_track_sfm_landmarks)
         }
     }
     ASSERT_GT(err.size(), 1000u);
-    std::nth_element(err.begin(), err.begin() + err.size() / 2, err.end());
-    const double median = err[err.size() / 2];
+    const double median = augocc::detail::median(err);
     std::cout << "cmu_hotel frames, augocc tracker + recoverCameras: " << tracks.points()
               << " tracks, model " << rep.chosenModel << ", own tracks median " << own.median
               << " px; 30 hand-labelled landmarks triangulated with these cameras: median "

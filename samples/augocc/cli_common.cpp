@@ -2,6 +2,8 @@
 
 #include "cli_common.hpp"
 
+#include <cctype>
+#include <climits>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -46,6 +48,95 @@ void requireFile(const std::string& flag, const std::string& path)
 {
     if (!std::filesystem::exists(path))
         throw UsageError(flag + " " + path + ": no such file or folder");
+}
+
+namespace {
+
+// `part` of a frame list item as a non-negative integer (below INT_MAX, so that a + 1 exists).
+int parseFrameNumber(const std::string& where, const std::string& part)
+{
+    long v = -1;
+    size_t used = 0;
+    if (!part.empty() && std::isdigit((unsigned char)part[0]))
+    {
+        try
+        {
+            v = std::stol(part, &used);
+        }
+        catch (const std::exception&)
+        {
+            used = 0;
+        }
+    }
+    if (part.empty() || used != part.size() || v < 0 || v >= INT_MAX)
+        throw UsageError(where + ": '" + part + "' is not a frame index (a non-negative "
+                         "integer)");
+    return (int)v;
+}
+
+} // namespace
+
+std::vector<FrameRange> parseFrameRanges(const std::string& flag, const std::string& text)
+{
+    std::vector<FrameRange> ranges;
+    size_t start = 0;
+    while (start <= text.size())
+    {
+        size_t comma = text.find(',', start);
+        if (comma == std::string::npos)
+            comma = text.size();
+        const std::string item = text.substr(start, comma - start);
+        start = comma + 1;
+        const std::string where = flag + " " + text + ": '" + item + "'";
+        std::vector<std::string> parts;
+        for (size_t from = 0;;)
+        {
+            const size_t colon = item.find(':', from);
+            parts.push_back(item.substr(from, colon == std::string::npos ? std::string::npos
+                                                                         : colon - from));
+            if (colon == std::string::npos)
+                break;
+            from = colon + 1;
+        }
+        if (item.empty() || parts.size() > 3)
+            throw UsageError(where + " is not a frame a, a range a:b (frames a..b-1), a: or "
+                             "a:b:step");
+        FrameRange r;
+        r.first = parseFrameNumber(where, parts[0]);
+        if (parts.size() == 1)
+            r.end = r.first + 1;
+        else if (!parts[1].empty())
+        {
+            r.end = parseFrameNumber(where, parts[1]);
+            if (r.end <= r.first)
+                throw UsageError(where + " is empty: a:b is frames a..b-1, b must be greater "
+                                 "than a");
+        }
+        if (parts.size() == 3)
+        {
+            r.step = parseFrameNumber(where, parts[2]);
+            if (r.step < 1)
+                throw UsageError(where + ": the step must be at least 1");
+        }
+        ranges.push_back(r);
+    }
+    return ranges;
+}
+
+std::set<int> listFrames(const std::string& flag, const std::string& text,
+                         const std::vector<FrameRange>& ranges, int frameCount)
+{
+    std::set<int> frames;
+    for (const FrameRange& r : ranges)
+    {
+        const int last = r.end < 0 ? std::max(frameCount - 1, r.first) : r.end - 1;
+        if (last >= frameCount)
+            throw UsageError(flag + " " + text + ": frame " + std::to_string(last) + " is "
+                             "beyond the last frame " + std::to_string(frameCount - 1));
+        for (long long f = r.first; f <= last; f += r.step)
+            frames.insert((int)f);
+    }
+    return frames;
 }
 
 } // namespace augocc_cli

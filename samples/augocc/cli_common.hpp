@@ -5,7 +5,9 @@
 #define AUGOCC_CLI_COMMON_HPP
 
 #include <chrono>
+#include <set>
 #include <string>
+#include <vector>
 #include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
 
@@ -44,6 +46,37 @@ void info(const Globals& g, const std::string& line);
 
 //! Throws UsageError naming the flag when the file does not exist.
 void requireFile(const std::string& flag, const std::string& path);
+
+//! One item of a frame list: frames first, first + step, ... before end.
+struct FrameRange
+{
+    int first = 0;
+    int end = -1;  //!< one past the last frame; -1: to the end of the input
+    int step = 1;
+};
+
+/** @brief Parses frames as every sub-command writes them (README, "Command line"): a
+comma-separated list of items, each a frame `a`, a half-open range `a:b` (frames a, a+1, ...,
+b-1, as a Python slice), `a:` (a to the last frame), or a range with a step, `a:b:s` or `a::s`
+(every s-th frame from a).
+@param flag the flag, named in the messages (`--frames`).
+@param text the flag's value.
+@return the items in the order given.
+
+Throws UsageError naming the flag and the item on anything else: an empty item, a part that is
+not a non-negative integer, b <= a, s < 1.
+*/
+std::vector<FrameRange> parseFrameRanges(const std::string& flag, const std::string& text);
+
+/** @brief The frames of `ranges` in an input of `frameCount` frames, sorted, each once.
+Throws UsageError naming `flag` when a frame of them is at or past `frameCount`.
+@param flag the flag, named in the messages.
+@param text the flag's value, quoted in the messages.
+@param ranges from parseFrameRanges(flag, text).
+@param frameCount frames in the input.
+*/
+std::set<int> listFrames(const std::string& flag, const std::string& text,
+                         const std::vector<FrameRange>& ranges, int frameCount);
 
 // Sub-command registration: one function per sub-command, each in its own cmd_<name>.cpp.
 void registerSynth(CLI::App& app, Globals& g);

@@ -28,14 +28,12 @@ void runComposite(const Globals& g, const CompositeCliOptions& o)
     CompositeOptions opt;
     if (!o.frames.empty())
     {
-        try
-        {
-            parseFrameRange(o.frames, opt.firstFrame, opt.endFrame);
-        }
-        catch (const cv::Exception& e)
-        {
-            throw UsageError("--frames " + e.err);
-        }
+        const std::vector<FrameRange> r = parseFrameRanges("--frames", o.frames);
+        if (r.size() != 1 || r[0].step != 1)
+            throw UsageError("--frames " + o.frames + ": composite takes one range of "
+                             "consecutive frames (a, a:b or a:)");
+        opt.firstFrame = r[0].first;
+        opt.endFrame = r[0].end;
     }
     const Reconstruction rec = readReconstruction(o.reconstruction);
     const Ptr<CloneSet> clones = CloneSet::load(o.clones);
@@ -72,8 +70,8 @@ void registerComposite(CLI::App& app, Globals& g)
     sub->add_option("--scene", o->scene, "scene.yml: the virtual objects")->required();
     sub->add_option("--out", o->out, "output video (.mp4 ...) or folder for %04d.png")
         ->required();
-    sub->add_option("--frames", o->frames, "a:b composites frames a..b-1 only (a render farm "
-                    "chunk); a: to the end");
+    sub->add_option("--frames", o->frames, "composite only frames a..b-1 as a:b (a render farm "
+                    "chunk), a: to the end, a for one frame (README, Command line)");
     sub->add_option("--mattes", o->mattes, "also write the clones' mattes, DIR/<object>/%04d.png");
     sub->add_option("--depth", o->depth, "also write depth, DIR/%04d.png 16-bit + DIR/depth.yml");
     sub->add_option("--virtual-layer", o->layer, "also write the virtual layer, DIR/%04d.png "

@@ -24,57 +24,11 @@ struct Options
     bool noSnap = false;
 };
 
-int parseInt(const std::string& text, const std::string& list)
-{
-    size_t used = 0;
-    int v = -1;
-    try
-    {
-        v = std::stoi(text, &used);
-    }
-    catch (const std::exception&)
-    {
-        used = 0;
-    }
-    if (used != text.size() || text.empty() || v < 0)
-        throw UsageError("--frames " + list + ": '" + text + "' is not a frame index");
-    return v;
-}
-
-// "3,7,10:20" -> {3, 7, 10, ..., 20} (ranges inclusive).
-std::set<int> parseFrameList(const std::string& list, int frameCount)
-{
-    std::set<int> frames;
-    size_t start = 0;
-    while (start <= list.size())
-    {
-        size_t comma = list.find(',', start);
-        if (comma == std::string::npos)
-            comma = list.size();
-        const std::string item = list.substr(start, comma - start);
-        const size_t colon = item.find(':');
-        int a, b;
-        if (colon == std::string::npos)
-            a = b = parseInt(item, list);
-        else
-        {
-            a = parseInt(item.substr(0, colon), list);
-            b = parseInt(item.substr(colon + 1), list);
-        }
-        if (a > b)
-            throw UsageError("--frames " + list + ": range '" + item + "' is empty");
-        if (b >= frameCount)
-            throw UsageError(format("--frames %s: frame %d is beyond the last frame %d",
-                                    list.c_str(), b, frameCount - 1));
-        for (int f = a; f <= b; ++f)
-            frames.insert(f);
-        start = comma + 1;
-    }
-    return frames;
-}
-
 void runPropagate(const Options& opt, const Globals& g)
 {
+    std::vector<FrameRange> ranges;
+    if (!opt.frames.empty())
+        ranges = parseFrameRanges("--frames", opt.frames);
     requireFile("--input", opt.input);
     const bool fromClones = !opt.clones.empty();
     if (fromClones == !opt.mattes.empty())
@@ -110,7 +64,7 @@ void runPropagate(const Options& opt, const Globals& g)
 
     std::set<int> frames;
     if (!opt.frames.empty())
-        frames = parseFrameList(opt.frames, frameCount);
+        frames = listFrames("--frames", opt.frames, ranges, frameCount);
     else if (fromClones)
         for (const Camera& c : rec.cameras)
             frames.insert(c.frame);
@@ -189,7 +143,8 @@ void registerPropagate(CLI::App& app, Globals& g)
     sub->add_option("--mattes", opt->mattes,
                     "instead of --clones: coarse masks MATTES/<object>/%04d.png to snap");
     sub->add_option("--frames", opt->frames,
-                    "frames, e.g. 5,9,20:30 (default: every frame with a camera / a matte)");
+                    "frames, e.g. 5,9,20:30 (20..29), 40::5 (README, Command line; default: every "
+                    "frame with a camera / a matte)");
     sub->add_option("--out", opt->out, "output masks folder MASKS/<object>/%04d.png")
         ->required();
     sub->add_option("--object", opt->objects, "only these objects (repeatable)");

@@ -6,8 +6,10 @@
 // started from the affine solution; recoverCameras(), the `augocc sfm` pipeline.
 
 #include "precomp.hpp"
+#include "ground_plane.hpp"
 #include "sfm_ceres.hpp"
 #include "sfm_detail.hpp"
+#include "stats.hpp"
 
 #include <deque>
 #include <Eigen/Geometry>
@@ -30,10 +32,9 @@ ReprojectionStats computeReprojectionStats(const Reconstruction& rec, const Trac
         const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
         for (int p = 0; p < tracks.points(); p++)
         {
-            const double* X = rec.points.ptr<double>(p);
-            if (!std::isfinite(row[p].x) || !std::isfinite(X[0]))
+            if (!std::isfinite(row[p].x) || !rec.hasPoint(p))
                 continue;
-            const Point2d q = cam.project(Vec3d(X[0], X[1], X[2]));
+            const Point2d q = cam.project(rec.point(p));
             const double d = std::hypot(q.x - row[p].x, q.y - row[p].y);
             e.push_back(d);
             s2 += d * d;
@@ -43,8 +44,8 @@ ReprojectionStats computeReprojectionStats(const Reconstruction& rec, const Trac
     if (e.empty())
         return st;
     st.rms = std::sqrt(s2 / e.size());
+    st.median = detail::median(e);
     std::sort(e.begin(), e.end());
-    st.median = e[e.size() / 2];
     st.p95 = e[std::min(e.size() - 1, (size_t)(0.95 * e.size()))];
     return st;
 }
@@ -149,22 +150,23 @@ void checkInput(const Tracks& tracks, const Reconstruction& rec)
     }
 }
 
-// Visits every observation of a finite point, point by point: the order in which the Schur
-// elimination visits the residual blocks, so that Ceres' blocks and the costs lie in memory in the
-// order they are used. fn(i, p, o, pp) gets the camera index, the point, the observation and the
-// camera's principal point; used[p] is set for every point with an observation.
+// Visits every observation of a reconstructed point (rec.hasPoint), point by point: the order in
+// which the Schur elimination visits the residual blocks, so that Ceres' blocks and the costs lie
+// in memory in the order they are used. fn(i, p, o, pp) gets the camera index, the point, the
+// observation and the camera's principal point; used (one flag per row of rec.points) is set for
+// every point with an observation.
 template <typename Fn>
-void forEachObservationPointMajor(const Tracks& tracks, const Reconstruction& rec, const Mat& X,
+void forEachObservationPointMajor(const Tracks& tracks, const Reconstruction& rec,
                                   std::vector<uchar>& used, Fn fn)
 {
     const int n = (int)rec.cameras.size();
     std::vector<Point2d> pp(n);
     for (int i = 0; i < n; i++)
         pp[i] = rec.cameras[i].principalPoint();
-    used.assign(X.rows, 0);
-    for (int p = 0; p < X.rows; p++)
+    used.assign(rec.points.rows, 0);
+    for (int p = 0; p < rec.points.rows; p++)
     {
-        if (!std::isfinite(X.at<double>(p, 0)))
+        if (!rec.hasPoint(p))
             continue;
         for (int i = 0; i < n; i++)
         {
@@ -216,10 +218,9 @@ bool OrthoCameraRefinerImpl::refinePositionZoom(const Tracks& tracks, Reconstruc
         std::vector<double> rotated, observed;
         for (int p = 0; p < tracks.points(); p++)
         {
-            const double* X = rec.points.ptr<double>(p);
-            if (!std::isfinite(row[p].x) || !std::isfinite(X[0]))
+            if (!std::isfinite(row[p].x) || !rec.hasPoint(p))
                 continue;
-            const Vec3d Xc = cam.R * Vec3d(X[0], X[1], X[2]);
+            const Vec3d Xc = cam.R * rec.point(p);
             rotated.push_back(Xc[0]);
             rotated.push_back(Xc[1]);
             observed.push_back(row[p].x);
@@ -287,7 +288,7 @@ bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction&
     std::unique_ptr<ceres::LossFunction> loss(makeLoss());
     ceres::ParameterBlockOrdering* ordering = new ceres::ParameterBlockOrdering;
     std::vector<uchar> used;
-    forEachObservationPointMajor(tracks, rec, X, used,
+    forEachObservationPointMajor(tracks, rec, used,
                                  [&](int i, int p, const Point2f& o, const Point2d& pp) {
         costs.emplace_back(o.x, o.y, pp.x, pp.y);
         problem.AddResidualBlock(&costs.back(), loss.get(), q[i].coeffs().data(), t[i].val,
@@ -363,7 +364,7 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
         CV_Error(Error::StsBadArg, "reconstruction: no finite point to refine");
     Mat X = rec.points.clone();
     for (int p = 0; p < P; p++)
-        if (std::isfinite(X.at<double>(p, 0)))
+        if (rec.hasPoint(p))
             for (int k = 0; k < 3; k++)
                 X.at<double>(p, k) -= c[k];
     std::vector<Eigen::Quaterniond> q(n);
@@ -401,7 +402,7 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     std::unique_ptr<ceres::LossFunction> loss(makeLoss());
     ceres::ParameterBlockOrdering* ordering = new ceres::ParameterBlockOrdering;
     std::vector<uchar> used;
-    forEachObservationPointMajor(tracks, rec, X, used,
+    forEachObservationPointMajor(tracks, rec, used,
                                  [&](int i, int p, const Point2f& o, const Point2d& pp) {
         costs.emplace_back(o.x, o.y, pp.x, pp.y);
         problem.AddResidualBlock(&costs.back(), loss.get(), q[i].coeffs().data(), t[i].val, &s,
@@ -534,10 +535,9 @@ double frontOfDominantPlane(const Reconstruction& rec)
     Vec3d m(0, 0, 0);
     for (int i = 0; i < rec.points.rows; i++)
     {
-        const double* x = rec.points.ptr<double>(i);
-        if (!std::isfinite(x[0]))
+        if (!rec.hasPoint(i))
             continue;
-        P.push_back(R * Vec3d(x[0], x[1], x[2]));   // first camera's axes: it looks along +z
+        P.push_back(R * rec.point(i));   // first camera's axes: it looks along +z
         m += P.back();
     }
     const int N = (int)P.size();
@@ -548,31 +548,11 @@ double frontOfDominantPlane(const Reconstruction& rec)
     for (const Vec3d& p : P)
         r2 += (p - m).dot(p - m);
     const double band = kPlaneBand * std::sqrt(r2 / N);
-    RNG rng(0x2545F491);
-    int best = 0;
-    Vec3d bestN;
-    double bestD = 0;
-    for (int trial = 0; trial < kPlaneTrials; trial++)
-    {
-        const Vec3d a = P[rng.uniform(0, N)], b = P[rng.uniform(0, N)], c = P[rng.uniform(0, N)];
-        Vec3d n = (b - a).cross(c - a);
-        const double nn = cv::norm(n);
-        if (!(nn > 0))
-            continue;
-        n *= 1.0 / nn;
-        const double d = n.dot(a);
-        int count = 0;
-        for (const Vec3d& p : P)
-            count += std::abs(n.dot(p) - d) < band;
-        if (count > best)
-        {
-            best = count;
-            bestN = n;
-            bestD = d;
-        }
-    }
-    if (best < 3)
+    const detail::PlaneFit plane = detail::ransacPlane(P, P, band, kPlaneTrials, 0x2545F491);
+    if (plane.inliers < 3)
         return -1;
+    Vec3d bestN = plane.normal;
+    double bestD = plane.offset;
     if (bestN[2] > 0)   // normal towards the camera
     {
         bestN = -bestN;
@@ -616,9 +596,9 @@ int rescueTracks(const Tracks& tracks, Reconstruction& rec)
     parallel_for_(Range(0, P), [&](const Range& r) {
         for (int p = r.start; p < r.end; p++)
         {
-            double* X = rec.points.ptr<double>(p);
-            if (std::isfinite(X[0]))
+            if (rec.hasPoint(p))
                 continue;
+            double* X = rec.points.ptr<double>(p);
             std::vector<const Camera*> cams;
             std::vector<Point2d> obs;
             for (const Camera& c : rec.cameras)

@@ -524,51 +524,12 @@ private:
                 glApi_.genBuffers(1, &g.keptIbo);
             }
             if (hasTex)
-                g.texture = uploadTexture(m.material.texture);
+                g.texture = detail::uploadTexture(m.material.texture);
             gpu_.push_back(g);
         }
         glApi_.bindBuffer(kArrayBuffer, 0);
         glApi_.bindBuffer(kElementArrayBuffer, 0);
         dirty_ = false;
-    }
-
-    static GLuint uploadTexture(const Mat& bgr)
-    {
-        // Texture coordinates have v up (mesh.hpp): GL's first row is t = 0, the image's bottom.
-        Mat rgb, flipped;
-        if (bgr.channels() == 1)
-            cv::cvtColor(bgr, rgb, COLOR_GRAY2RGB);
-        else if (bgr.channels() == 4)
-            cv::cvtColor(bgr, rgb, COLOR_BGRA2RGB);
-        else
-            cv::cvtColor(bgr, rgb, COLOR_BGR2RGB);
-        if (rgb.depth() != CV_8U)
-            rgb.convertTo(rgb, CV_8U, rgb.depth() == CV_16U ? 1.0 / 257 : 255.0);
-        cv::flip(rgb, flipped, 0);
-        GLuint tex = 0;
-        glGenTextures(1, &tex);
-        glBindTexture(GL_TEXTURE_2D, tex);
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-        // Every mipmap level made on the CPU by INTER_AREA halving, as the synthesizer does, so
-        // that both sample a texture identically.
-        Mat cur = flipped;
-        for (int level = 0;; level++)
-        {
-            glTexImage2D(GL_TEXTURE_2D, level, GL_RGB8, cur.cols, cur.rows, 0, GL_RGB,
-                         GL_UNSIGNED_BYTE, cur.data);
-            if (cur.cols == 1 && cur.rows == 1)
-                break;
-            Mat next;
-            cv::resize(cur, next, Size(std::max(1, cur.cols / 2), std::max(1, cur.rows / 2)), 0,
-                       0, INTER_AREA);
-            cur = next;
-        }
-        glBindTexture(GL_TEXTURE_2D, 0);
-        return tex;
     }
 
     // Near/far planes in camera z around the virtual objects, with a 5% margin. The depth

@@ -8,6 +8,7 @@
 
 #include "precomp.hpp"
 #include "sfm_detail.hpp"
+#include "stats.hpp"
 
 #include <numeric>
 #include <Eigen/Dense>
@@ -321,26 +322,27 @@ FactorizationSfM::Params::Params()
 
 namespace {
 
-// Moves the finite points (rows of `points`) so that their centroid is the origin; `centre` is
-// that centroid before the move. Returns their RMS radius (the scale of the cameras' depth).
-double centrePoints(Mat& points, Vec3d& centre)
+// Moves the reconstructed points of `rec` so that their centroid is the origin; `centre` is that
+// centroid before the move. Returns their RMS radius (the scale of the cameras' depth).
+double centrePoints(Reconstruction& rec, Vec3d& centre)
 {
-    const double radius = detail::rmsRadius(points, &centre);
-    for (int p = 0; p < points.rows; p++)
-        if (std::isfinite(points.at<double>(p, 0)))
+    const double radius = detail::rmsRadius(rec.points, &centre);
+    for (int p = 0; p < rec.points.rows; p++)
+        if (rec.hasPoint(p))
             for (int k = 0; k < 3; k++)
-                points.at<double>(p, k) -= centre[k];
+                rec.points.at<double>(p, k) -= centre[k];
     return radius;
 }
 
-// The inlier flags of reconstruct(): 1 where a track's point was kept (finite), 0 where rejected.
-void writeInliers(const Mat& points, OutputArray inliersOut)
+// The inlier flags of reconstruct(): 1 where a track's point was kept (hasPoint), 0 where
+// rejected.
+void writeInliers(const Reconstruction& rec, OutputArray inliersOut)
 {
     if (!inliersOut.needed())
         return;
-    Mat inl(points.rows, 1, CV_8U);
-    for (int p = 0; p < points.rows; p++)
-        inl.at<uchar>(p) = std::isfinite(points.at<double>(p, 0)) ? 1 : 0;
+    Mat inl(rec.points.rows, 1, CV_8U);
+    for (int p = 0; p < rec.points.rows; p++)
+        inl.at<uchar>(p) = rec.hasPoint(p) ? 1 : 0;
     inl.copyTo(inliersOut);
 }
 
@@ -940,10 +942,8 @@ bool FactorizationSfMImpl::reconstructIncremental(SfmData& d, Reconstruction& ou
             const double ssr = trackSsr(d, tr[c], m, Vec3d(x[0], x[1], x[2]), n);
             res[c] = std::sqrt(ssr / std::max(1, n));
         }
-        std::vector<double> sorted = res;
-        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
         const double thr = std::max(params_.outlierThreshold,
-                                    params_.outlierSigmas * sorted[sorted.size() / 2]);
+                                    params_.outlierSigmas * detail::median(res));
         std::vector<int> kept;
         for (size_t c = 0; c < tr.size(); c++)
             if (res[c] <= thr)
@@ -1042,7 +1042,7 @@ bool FactorizationSfMImpl::reconstructIncremental(SfmData& d, Reconstruction& ou
             rec.points.at<double>(p, k) = Xw[k];
     }
     Vec3d c;
-    const double depth = params_.depthRatio * std::max(centrePoints(rec.points, c), 1.0);
+    const double depth = params_.depthRatio * std::max(centrePoints(rec, c), 1.0);
     for (int f = 0; f < F; f++)
     {
         if (!views[f].solved)
@@ -1054,7 +1054,7 @@ bool FactorizationSfMImpl::reconstructIncremental(SfmData& d, Reconstruction& ou
         rec.cameras.push_back(Camera::orthographic(R, t, views[f].s / sMean, pp, f));
     }
     out = rec;
-    writeInliers(rec.points, inliersOut);
+    writeInliers(rec, inliersOut);
     return true;
 }
 
@@ -1147,8 +1147,7 @@ bool FactorizationSfMImpl::reconstruct(const Tracks& tracks, Reconstruction& out
                 r.push_back(resid[p]);
         if (r.empty())
             break;
-        std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-        const double med = r[r.size() / 2];
+        const double med = detail::median(r);
         const double thr = std::max(params_.outlierThreshold, params_.outlierSigmas * med);
         std::vector<uchar> next(P, 0);
         int changed = 0, nNext = 0;
@@ -1261,7 +1260,7 @@ bool FactorizationSfMImpl::reconstruct(const Tracks& tracks, Reconstruction& out
         rec.points.at<double>(p, 2) = Xw[2];
     }
     Vec3d c;
-    const double depth = params_.depthRatio * std::max(centrePoints(rec.points, c), 1.0);
+    const double depth = params_.depthRatio * std::max(centrePoints(rec, c), 1.0);
     for (int f = 0; f < F; f++)
     {
         if (!solvedFrame[f])
@@ -1273,10 +1272,9 @@ bool FactorizationSfMImpl::reconstruct(const Tracks& tracks, Reconstruction& out
         for (int i = d.idx.frameStart[f]; i < d.idx.frameStart[f + 1]; i++)
         {
             const SfmObservation& o = d.idx.byFrame[i];
-            if (!std::isfinite(rec.points.at<double>(o.point, 0)))
+            if (!rec.hasPoint(o.point))
                 continue;
-            const double* X = rec.points.ptr<double>(o.point);
-            const Vec3d Xc = cam.R * Vec3d(X[0], X[1], X[2]);
+            const Vec3d Xc = cam.R * rec.point(o.point);
             su += (o.u - pp.x) - Xc[0];
             sv2 += (o.v - pp.y) - Xc[1];
             n++;
@@ -1285,7 +1283,7 @@ bool FactorizationSfMImpl::reconstruct(const Tracks& tracks, Reconstruction& out
         rec.cameras.push_back(cam);
     }
     out = rec;
-    writeInliers(rec.points, inliersOut);
+    writeInliers(rec, inliersOut);
     return true;
 }
 

@@ -34,6 +34,7 @@
 #include "precomp.hpp"
 #include "sfm_ceres.hpp"
 #include "sfm_detail.hpp"
+#include "stats.hpp"
 
 #include <deque>
 #include <Eigen/Dense>
@@ -603,8 +604,7 @@ int IncrementalBuilder::rejectTracks()
             r.push_back(rms[p]);
     if (r.empty())
         return 0;
-    std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-    thr_ = std::max(floor_, sigmas_ * r[r.size() / 2]);
+    thr_ = std::max(floor_, sigmas_ * detail::median(r));
     int n = 0;
     for (int p = 0; p < P; p++)
         if (rms[p] > thr_)

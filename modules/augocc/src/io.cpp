@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "precomp.hpp"
+#include "io_internal.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -18,25 +19,6 @@ namespace {
 bool isFinite2(const Point2f& p)
 {
     return std::isfinite(p.x) && std::isfinite(p.y);
-}
-
-// Opens a FileStorage for reading with a clear error naming the file.
-FileStorage openForRead(const String& path)
-{
-    if (!fs::exists(path))
-        CV_Error(Error::StsObjectNotFound, path + ": file not found");
-    FileStorage storage;
-    try
-    {
-        storage.open(path, FileStorage::READ);
-    }
-    catch (const cv::Exception& e)
-    {
-        CV_Error(Error::StsParseError, path + ": cannot parse (" + e.err + ")");
-    }
-    if (!storage.isOpened())
-        CV_Error(Error::StsParseError, path + ": cannot open or parse as a FileStorage file");
-    return storage;
 }
 
 FileNode requireKey(const FileNode& parent, const char* key, const String& where)
@@ -135,6 +117,29 @@ String tmpNameFor(const String& path)
 
 } // namespace
 
+namespace detail {
+
+FileStorage openFileStorageForRead(const String& path, const String& what)
+{
+    if (!fs::is_regular_file(path))
+        CV_Error(Error::StsObjectNotFound, path + ": " + what + " not found");
+    FileStorage storage;
+    try
+    {
+        storage.open(path, FileStorage::READ);
+    }
+    catch (const cv::Exception& e)
+    {
+        CV_Error(Error::StsParseError, path + ": cannot parse " + what + ": " + e.err);
+    }
+    if (!storage.isOpened())
+        CV_Error(Error::StsParseError, path + ": cannot open or parse " + what + " as a "
+                 "FileStorage file");
+    return storage;
+}
+
+} // namespace detail
+
 void writeAtomically(const String& path, const std::function<void(const String& tmpPath)>& writer)
 {
     const String tmp = tmpNameFor(path);
@@ -197,7 +202,7 @@ void Tracks::validate(const String& what) const
 
 Tracks readTracks(const String& path)
 {
-    FileStorage storage = openForRead(path);
+    FileStorage storage = detail::openFileStorageForRead(path);
     FileNode root = storage.root();
     Tracks t;
     t.imageSize = readImageSize(root, path);
@@ -303,7 +308,7 @@ void Reconstruction::validate(const String& what) const
 
 Reconstruction readReconstruction(const String& path)
 {
-    FileStorage storage = openForRead(path);
+    FileStorage storage = detail::openFileStorageForRead(path);
     FileNode root = storage.root();
     Reconstruction rec;
     FileNode modelNode = requireKey(root, "model", path);

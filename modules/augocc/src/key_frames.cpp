@@ -193,30 +193,26 @@ std::vector<uchar> objectTracksFromMasks(const Tracks& tracks, const FrameMasks&
         for (int p = r.start; p < r.end; ++p)
         {
             bool haveHull = false;
-            if (rec && !rec->points.empty())
+            if (rec && rec->hasPoint(p))
             {
-                const double* X = rec->points.ptr<double>(p);
-                if (std::isfinite(X[0]) && std::isfinite(X[1]) && std::isfinite(X[2]))
+                bool in = true;
+                int tested = 0;
+                for (const auto& fm : masks)
                 {
-                    bool in = true;
-                    int tested = 0;
-                    for (const auto& fm : masks)
+                    const int ci = rec->findCamera(fm.first);
+                    if (ci < 0)
+                        continue;
+                    ++tested;
+                    if (!inside(fm.second, rec->cameras[ci].project(rec->point(p))))
                     {
-                        const int ci = rec->findCamera(fm.first);
-                        if (ci < 0)
-                            continue;
-                        ++tested;
-                        if (!inside(fm.second, rec->cameras[ci].project(Vec3d(X[0], X[1], X[2]))))
-                        {
-                            in = false;
-                            break;
-                        }
+                        in = false;
+                        break;
                     }
-                    if (tested > 0)
-                    {
-                        haveHull = true;
-                        flags[p] = in ? 1 : 0;
-                    }
+                }
+                if (tested > 0)
+                {
+                    haveHull = true;
+                    flags[p] = in ? 1 : 0;
                 }
             }
             if (haveHull)

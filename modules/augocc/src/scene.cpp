@@ -5,6 +5,8 @@
 // placement helpers that put objects relative to the clones of what the user sees.
 
 #include "precomp.hpp"
+#include "ground_plane.hpp"
+#include "io_internal.hpp"
 
 #include <filesystem>
 #include <set>
@@ -134,19 +136,7 @@ std::vector<Mesh> proceduralShape(const String& shape)
 
 VirtualScene readScene(const String& path)
 {
-    if (!fs::is_regular_file(path))
-        CV_Error(Error::StsObjectNotFound, path + ": scene file not found");
-    FileStorage fsIn;
-    try
-    {
-        fsIn.open(path, FileStorage::READ);
-    }
-    catch (const cv::Exception& e)
-    {
-        CV_Error(Error::StsParseError, path + ": cannot parse scene file: " + e.err);
-    }
-    if (!fsIn.isOpened())
-        CV_Error(Error::StsParseError, path + ": cannot parse scene file");
+    const FileStorage fsIn = detail::openFileStorageForRead(path, "scene file");
     const FileNode root = fsIn.root();
     const char* const rootKeys[] = {"objects"};
     checkKeys(root, rootKeys, 1, path, "top level");
@@ -337,18 +327,6 @@ Vec3d GroundFrame::fromGround(const Vec3d& g) const
     return right * g[0] + up * (g[1] + height) + back * g[2];
 }
 
-namespace {
-
-// Eigen-decomposition helper: eigenvector of the smallest eigenvalue of a symmetric 3x3.
-Vec3d leastEigenvector(const Matx33d& S)
-{
-    Mat evals, evecs;
-    cv::eigen(Mat(S), evals, evecs);  // descending
-    return Vec3d(evecs.at<double>(2, 0), evecs.at<double>(2, 1), evecs.at<double>(2, 2));
-}
-
-} // namespace
-
 GroundFrame estimateGround(const Reconstruction& rec)
 {
     if (rec.cameras.empty())
@@ -378,94 +356,13 @@ GroundFrame estimateGround(const Reconstruction& rec)
         up = -up;
 
     GroundFrame g;
-    // Ground plane from the points.
+    // Ground plane from the points (detail::fitGroundPlane, ground_plane.cpp).
     std::vector<Vec3d> pts;
-    if (!rec.points.empty())
-        for (int i = 0; i < rec.points.rows; i++)
-        {
-            const double* p = rec.points.ptr<double>(i);
-            if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
-                pts.push_back(Vec3d(p[0], p[1], p[2]));
-        }
-    double height = 0;
-    bool fromPlane = false;
-    if (pts.size() >= 10)
-    {
-        std::vector<double> h(pts.size());
-        for (size_t i = 0; i < pts.size(); i++)
-            h[i] = up.dot(pts[i]);
-        std::vector<double> hs = h;
-        std::sort(hs.begin(), hs.end());
-        const double hMedian = hs[hs.size() / 2];
-        height = hs[(size_t)(0.02 * (hs.size() - 1))];
-        // Spread of the scene along up: the inlier band is 1% of it.
-        const double extent = std::max(hs.back() - hs.front(), 1e-12);
-        const double kInlierFraction = 0.01;
-        const double tol = kInlierFraction * extent;
-        const double kMaxTiltDeg = 15.0;
-        std::vector<Vec3d> low;
-        for (size_t i = 0; i < pts.size(); i++)
-            if (h[i] <= hMedian)
-                low.push_back(pts[i]);
-        // Deterministic RANSAC (fixed seed) over the lower half of the points.
-        RNG rng(0x5eed);
-        size_t bestCount = 0;
-        Vec3d bestN = up;
-        double bestD = height;
-        const int kIterations = 500;
-        for (int it = 0; it < kIterations && low.size() >= 3; it++)
-        {
-            const Vec3d& a = low[rng.uniform(0, (int)low.size())];
-            const Vec3d& b = low[rng.uniform(0, (int)low.size())];
-            const Vec3d& c = low[rng.uniform(0, (int)low.size())];
-            Vec3d n = (b - a).cross(c - a);
-            const double len = cv::norm(n);
-            if (!(len > 0))
-                continue;
-            n *= 1.0 / len;
-            if (n.dot(up) < 0)
-                n = -n;
-            if (n.dot(up) < std::cos(kMaxTiltDeg * CV_PI / 180))
-                continue;
-            const double d = n.dot(a);
-            size_t count = 0;
-            for (const Vec3d& p : pts)
-                if (std::abs(n.dot(p) - d) < tol)
-                    count++;
-            if (count > bestCount)
-            {
-                bestCount = count;
-                bestN = n;
-                bestD = d;
-            }
-        }
-        // A plane holds the ground when it carries a tenth of the points (at least 10).
-        const size_t kMinInliers = std::max<size_t>(10, pts.size() / 10);
-        if (bestCount >= kMinInliers)
-        {
-            // Least-squares refit on the inliers.
-            Vec3d centroid(0, 0, 0);
-            std::vector<Vec3d> in;
-            for (const Vec3d& p : pts)
-                if (std::abs(bestN.dot(p) - bestD) < tol)
-                    in.push_back(p);
-            for (const Vec3d& p : in)
-                centroid += p;
-            centroid *= 1.0 / in.size();
-            Matx33d C = Matx33d::zeros();
-            for (const Vec3d& p : in)
-                C += (p - centroid) * (p - centroid).t();
-            Vec3d n = leastEigenvector(C);
-            if (n.dot(up) < 0)
-                n = -n;
-            up = n;
-            height = n.dot(centroid);
-            fromPlane = true;
-        }
-    }
+    for (int i = 0; i < rec.points.rows; i++)
+        if (rec.hasPoint(i))
+            pts.push_back(rec.point(i));
+    g.fromPlane = detail::fitGroundPlane(pts, up, g.height);
     g.up = up;
-    g.height = height;
-    g.fromPlane = fromPlane;
     // Horizontal mean view direction: "behind" is away from the viewer.
     Vec3d f = meanView - up * up.dot(meanView);
     if (cv::norm(f) < 1e-6)

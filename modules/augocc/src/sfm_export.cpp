@@ -109,8 +109,7 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
             {
                 if (!std::isfinite(row[p].x))
                     continue;
-                const double* X = rec.points.ptr<double>(p);
-                const bool has3d = std::isfinite(X[0]);
+                const bool has3d = rec.hasPoint(p);
                 if (!firstPt)
                     out << ' ';
                 firstPt = false;
@@ -118,7 +117,7 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
                 if (has3d)
                 {
                     pointTrack[p].emplace_back(id, idx);
-                    const Point2d q2 = cam.project(Vec3d(X[0], X[1], X[2]));
+                    const Point2d q2 = cam.project(rec.point(p));
                     errSum[p] += std::hypot(q2.x - row[p].x, q2.y - row[p].y);
                 }
                 idx++;
@@ -148,9 +147,9 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
                "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n";
         for (int p = 0; p < P; p++)
         {
-            const double* X = rec.points.ptr<double>(p);
-            if (!std::isfinite(X[0]) || pointTrack[p].empty())
+            if (!rec.hasPoint(p) || pointTrack[p].empty())
                 continue;
+            const Vec3d X = rec.point(p);
             Vec3b bgr(128, 128, 128);
             if (!colors.empty())
                 bgr = colors.at<Vec3b>(p);
@@ -171,9 +170,7 @@ void writePointsPly(const String& path, const Reconstruction& rec, InputArray co
         CV_Error(Error::StsBadArg, "writePointsPly: reconstruction points must be P x 3 "
                  "CV_64F");
     const Mat colors = checkColors(colorsArg, rec.points.rows, "writePointsPly");
-    int n = 0;
-    for (int p = 0; p < rec.points.rows; p++)
-        n += std::isfinite(rec.points.at<double>(p, 0)) ? 1 : 0;
+    const int n = rec.validPointCount();
     writeAtomically(path, [&](const String& tmp) {
         std::ofstream out;
         openOrThrow(out, tmp);
@@ -185,9 +182,9 @@ void writePointsPly(const String& path, const Reconstruction& rec, InputArray co
         out << "end_header\n";
         for (int p = 0; p < rec.points.rows; p++)
         {
-            const double* X = rec.points.ptr<double>(p);
-            if (!std::isfinite(X[0]))
+            if (!rec.hasPoint(p))
                 continue;
+            const Vec3d X = rec.point(p);
             out << X[0] << ' ' << X[1] << ' ' << X[2];
             if (!colors.empty())
             {

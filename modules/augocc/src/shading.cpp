@@ -20,6 +20,43 @@ Vec3f shadeColor(const Material& material, const Vec3f& normal, const Vec3f& bas
     return c;
 }
 
+unsigned uploadTexture(const Mat& image)
+{
+    // RGB, bottom row first (v up), then every mipmap level down to 1x1.
+    Mat rgb;
+    if (image.channels() == 1)
+        cv::cvtColor(image, rgb, COLOR_GRAY2RGB);
+    else if (image.channels() == 4)
+        cv::cvtColor(image, rgb, COLOR_BGRA2RGB);
+    else
+        cv::cvtColor(image, rgb, COLOR_BGR2RGB);
+    if (rgb.depth() != CV_8U)
+        rgb.convertTo(rgb, CV_8U, rgb.depth() == CV_16U ? 1.0 / 257 : 255.0);
+    cv::flip(rgb, rgb, 0);
+    GLuint id = 0;
+    glGenTextures(1, &id);
+    glBindTexture(GL_TEXTURE_2D, id);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    Mat cur = rgb.isContinuous() ? rgb : rgb.clone();
+    for (int level = 0;; level++)
+    {
+        glTexImage2D(GL_TEXTURE_2D, level, GL_RGB8, cur.cols, cur.rows, 0, GL_RGB,
+                     GL_UNSIGNED_BYTE, cur.data);
+        if (cur.cols == 1 && cur.rows == 1)
+            break;
+        Mat next;
+        cv::resize(cur, next, Size(std::max(1, cur.cols / 2), std::max(1, cur.rows / 2)), 0, 0,
+                   INTER_AREA);
+        cur = next;
+    }
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return id;
+}
+
 GlMesh::GlMesh(const Mesh& meshIn, float alpha)
 {
     const Mesh* mesh = &meshIn;
@@ -61,43 +98,7 @@ GlMesh::GlMesh(const Mesh& meshIn, float alpha)
         texcoords_[2 * i] = mesh->texcoords[i][0];
         texcoords_[2 * i + 1] = mesh->texcoords[i][1];
     }
-    // RGB, bottom row first (v up), then every mipmap level down to 1x1 (INTER_AREA halving,
-    // deterministic on the CPU rather than whatever the driver's generator does).
-    Mat rgb;
-    const Mat& tex = mesh->material.texture;
-    if (tex.channels() == 1)
-        cv::cvtColor(tex, rgb, COLOR_GRAY2RGB);
-    else if (tex.channels() == 4)
-        cv::cvtColor(tex, rgb, COLOR_BGRA2RGB);
-    else
-        cv::cvtColor(tex, rgb, COLOR_BGR2RGB);
-    if (rgb.depth() != CV_8U)
-        rgb.convertTo(rgb, CV_8U, rgb.depth() == CV_16U ? 1.0 / 257 : 255.0);
-    cv::flip(rgb, rgb, 0);
-    GLuint id = 0;
-    glGenTextures(1, &id);
-    texture_ = id;
-    glBindTexture(GL_TEXTURE_2D, id);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    int level = 0;
-    Mat cur = rgb.isContinuous() ? rgb : rgb.clone();
-    while (true)
-    {
-        glTexImage2D(GL_TEXTURE_2D, level, GL_RGB8, cur.cols, cur.rows, 0, GL_RGB,
-                     GL_UNSIGNED_BYTE, cur.data);
-        if (cur.cols == 1 && cur.rows == 1)
-            break;
-        Mat next;
-        cv::resize(cur, next, Size(std::max(1, cur.cols / 2), std::max(1, cur.rows / 2)), 0, 0,
-                   INTER_AREA);
-        cur = next;
-        level++;
-    }
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-    glBindTexture(GL_TEXTURE_2D, 0);
+    texture_ = uploadTexture(mesh->material.texture);
 }
 
 GlMesh::~GlMesh()

@@ -40,8 +40,21 @@ texture: base * (ambient + diffuse * max(0, n . L)), clamped.
 Vec3f shadeColor(const Material& material, const Vec3f& normal,
                  const Vec3f& base = Vec3f(1, 1, 1));
 
+/** @brief Uploads `image` as a GL_TEXTURE_2D of the current OpenGL context and returns its name
+(the caller deletes it with glDeleteTextures, in that context).
+
+The one texture upload of the compositor and the synthesizer, so that both sample a texture
+identically: RGB8 from a grey, BGR or BGRA image (16-bit scaled by 1/257, floating point by 255),
+bottom row first (texture coordinates have v up), and every mipmap level down to 1x1 made on the
+CPU by INTER_AREA halving (deterministic, rather than whatever the driver's generator does);
+trilinear minification, linear magnification, GL_REPEAT in s and t. Leaves GL_UNPACK_ALIGNMENT at 1
+and no texture bound.
+@param image the texture image, as Material::texture holds it.
+*/
+unsigned uploadTexture(const Mat& image);
+
 /** @brief A mesh ready to draw in the current OpenGL context (fixed pipeline, vertex arrays):
-per-vertex lit colours computed once (shadeColor), texture uploaded with mipmaps.
+per-vertex lit colours computed once (shadeColor), texture uploaded by uploadTexture().
 
 Make the owning context current before creating, drawing or destroying it (the texture belongs
 to that context). Normals are computed (smooth) when the mesh has none.

@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "precomp.hpp"
+#include "stats.hpp"
 
 #include <opencv2/imgproc/segmentation.hpp>
 
@@ -856,9 +857,7 @@ private:
             const float kWeakEdgeRatio = 0.25f;
             const int kMedianHalf = 2;
             const float kOutlierPx = 1.5f;
-            std::vector<float> sorted = score;
-            std::nth_element(sorted.begin(), sorted.begin() + samples / 2, sorted.end());
-            const float medScore = sorted[samples / 2];
+            const float medScore = detail::median(score);
             for (int k = 0; k < samples; ++k)
                 if (score[k] < kWeakEdgeRatio * medScore)
                     offset[k] = 0.f;
@@ -868,9 +867,8 @@ private:
                 std::vector<float> w;
                 for (int d = -kMedianHalf; d <= kMedianHalf; ++d)
                     w.push_back(offset[(k + d + samples) % samples]);
-                std::nth_element(w.begin(), w.begin() + kMedianHalf, w.end());
-                filtered[k] = std::abs(offset[k] - w[kMedianHalf]) > kOutlierPx ? w[kMedianHalf]
-                                                                                : offset[k];
+                const float m = detail::medianInPlace(w);
+                filtered[k] = std::abs(offset[k] - m) > kOutlierPx ? m : offset[k];
             }
             ContourData cd;
             cd.closed = true;

@@ -24,6 +24,7 @@ the real objects, and compositing by depth test.
 #include "opencv2/augocc/compositor.hpp"
 #include "opencv2/augocc/scene.hpp"
 #include "opencv2/augocc/pipeline.hpp"
+#include "opencv2/augocc/evaluation.hpp"
 #include "opencv2/augocc/silhouette_editor.hpp"
 #include "opencv2/augocc/key_frames.hpp"
 #include "opencv2/augocc/visualization.hpp"

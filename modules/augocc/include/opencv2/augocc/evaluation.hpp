@@ -1,0 +1,65 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+#ifndef OPENCV_AUGOCC_EVALUATION_HPP
+#define OPENCV_AUGOCC_EVALUATION_HPP
+
+#include <opencv2/core.hpp>
+#include "opencv2/augocc/io.hpp"
+
+/*
+Scores against a ground truth, for `augocc demo`, the tests and the perf suite: a composite
+against the truth rendered with the virtual objects, and the similarity that brings a
+reconstruction into the world of a reference one (the synthesizer's ground truth) so that the two
+can be compared.
+*/
+
+namespace cv {
+namespace augocc {
+
+//! @addtogroup augocc
+//! @{
+
+//! Scores of a composite against the ground truth (see scoreComposite()).
+struct CV_EXPORTS CompositeScore
+{
+    double fractionWithin = 0;     //!< fraction of pixels whose grey level is within tolerance
+    double boundaryDistance = 0;   //!< mean distance (px) between occlusion boundaries, symmetric
+    double bandError = 0;          //!< mean |colour error| (0-255, per channel) in the band
+    int boundaryPixels = 0;        //!< occlusion-boundary pixels of the ground truth
+    int bandPixels = 0;            //!< pixels of the band
+};
+
+/** @brief Compares one composite with the ground truth.
+
+@param composite the composite, BGR CV_8UC3.
+@param truth the ground truth (e.g. SceneSynthesizer::renderWithVirtual()), BGR CV_8UC3.
+@param visible CV_8U, > 127 where the composite shows the virtual objects (coverage >= 1/2).
+@param visibleTruth CV_8U, > 127 where the virtual objects are visible in the truth.
+@param silhouette CV_8U, > 127 where the virtual objects project (visible or hidden).
+@param greyTolerance grey-level tolerance of fractionWithin (the issue's 8).
+@param bandRadius half-width in pixels of the band around the true occlusion boundary.
+
+The occlusion boundary is the boundary of the visible region that is not the boundary of the
+silhouette: where a real object cuts the virtual one. boundaryDistance averages, over the
+boundary pixels of each side, the distance to the other side's visible boundary (0 when the
+truth has no occlusion boundary and neither has the composite). bandError is measured in the
+pixels within bandRadius of the true occlusion boundary.
+*/
+CV_EXPORTS CompositeScore scoreComposite(InputArray composite, InputArray truth, InputArray visible,
+                                         InputArray visibleTruth, InputArray silhouette,
+                                         int greyTolerance = 8, int bandRadius = 2);
+
+/** @brief Similarity that maps the world of `rec` onto the world of `reference` (X_ref =
+M * X_rec), estimated from the cameras of the frames both have: rotation from the camera
+rotations, scale from the zooms (or a joint least-squares with the translation for PERSPECTIVE),
+translation by least squares on the camera translations. Used to compare a reconstruction with
+the synthetic ground truth. Throws StsBadArg without three common frames. */
+CV_EXPORTS Matx44d alignReconstructions(const Reconstruction& rec, const Reconstruction& reference);
+
+//! @}
+
+} // namespace augocc
+} // namespace cv
+
+#endif
