@@ -75,13 +75,12 @@ public:
 
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        int mode;                //!< Mode (default POSITION_ZOOM)
-        int loss;                //!< Loss for FULL_BA and PERSPECTIVE_BA (default LOSS_HUBER)
-        double lossScale;        //!< pixels at which the robust loss bends (default 2.0)
-        bool perFrameScale;      //!< FULL_BA: one zoom per frame instead of one (default false)
-        int maxIterations;       //!< Levenberg-Marquardt iterations at most (default 50)
-        double functionTolerance;//!< Ceres function_tolerance (default 1e-6)
+        int mode = POSITION_ZOOM;          //!< Mode
+        int loss = LOSS_HUBER;             //!< Loss for FULL_BA and PERSPECTIVE_BA
+        double lossScale = 2.0;            //!< pixels at which the robust loss bends
+        bool perFrameScale = false;        //!< FULL_BA: one zoom per frame instead of one
+        int maxIterations = 50;            //!< Levenberg-Marquardt iterations at most
+        double functionTolerance = 1e-6;   //!< Ceres function_tolerance
     };
 
     static Ptr<OrthoCameraRefiner> create(const Params& params);

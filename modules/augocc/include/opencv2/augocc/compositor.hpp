@@ -49,35 +49,34 @@ class CV_EXPORTS Compositor : public Algorithm
 public:
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        /** Supersampling factor of the depth test against the real objects (default 3): the
-        occluder depth is sampled k x k per pixel. 1 gives the paper's hard depth test; 3 makes
-        occlusion edges soft (see doc/compositor.md for the measured error). */
-        int supersample;
+        /** Supersampling factor of the depth test against the real objects: the occluder depth
+        is sampled k x k per pixel. 1 gives the paper's hard depth test; 3 makes occlusion
+        edges soft (see doc/compositor.md for the measured error). */
+        int supersample = 3;
         /** With supersample k > 1: also render the virtual objects at k x (anti-aliases their
-        own outlines against the frame, at k^2 the rasterising cost). Default false: the virtual
-        layer is rendered at the frame's resolution and only the depth test against the real
-        objects runs at k x k samples per pixel (each against the pixel's virtual depth), which
-        is what makes occlusion edges soft (doc/compositor.md: same edge error, 2.3x faster). */
-        bool antialiasVirtual;
+        own outlines against the frame, at k^2 the rasterising cost). Off: the virtual layer is
+        rendered at the frame's resolution and only the depth test against the real objects
+        runs at k x k samples per pixel (each against the pixel's virtual depth), which is what
+        makes occlusion edges soft (doc/compositor.md: same edge error, 2.3x faster). */
+        bool antialiasVirtual = false;
         /** Cull the back faces of meshes that are closed and outward-oriented (checked per mesh
         when uploaded; such back faces are never visible, so no pixel changes). Halves the
-        triangles the rasteriser sets up (default true). */
-        bool cullBackFaces;
+        triangles the rasteriser sets up. */
+        bool cullBackFaces = true;
         /** Optional occlusion-edge refinement: radius in frame pixels of a guided filter
         (cv::ximgproc::guidedFilter, guided by the frame) that re-estimates the visible fraction
         of the virtual objects around the occlusion boundary, so that it follows the real
-        object's edge in the image. Default 0 (off): on richly textured real objects the filter
+        object's edge in the image. 0 = off: on richly textured real objects the filter
         follows the texture and measured worse than the supersampled depth test alone
         (doc/compositor.md); it helps on plain objects with clean edges. */
-        int edgeRadius;
-        //! Regularisation of that guided filter, guide in [0, 1] (default 1e-2).
-        double edgeEps;
+        int edgeRadius = 0;
+        //! Regularisation of that guided filter, guide in [0, 1].
+        double edgeEps = 1e-2;
         /** Rotation from the world of the reconstruction to the shading frame (y up) in which
-        the light of the shading convention is fixed (default identity: the world is y up, as
-        the synthesizer's). For a reconstruction, use the rows (right, up, back) of its
+        the light of the shading convention is fixed (identity: the world is y up, as the
+        synthesizer's). For a reconstruction, use the rows (right, up, back) of its
         estimateGround() frame, so that the sun shines from above whatever the world's axes. */
-        Matx33d lightRotation;
+        Matx33d lightRotation = Matx33d::eye();
     };
 
     static Ptr<Compositor> create(const Params& params);

@@ -58,15 +58,14 @@ class CV_EXPORTS FactorizationSfM : public Algorithm
 public:
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        int minTrackLength;        //!< tracks seen in fewer frames are not used (default 2)
-        int maxAlternations;       //!< missing data: alternation iterations at most (default 300)
-        double alternationTol;     //!< missing data: stop when RMS improves by less (rel.) (1e-7)
-        bool rejectOutliers;       //!< reject gross-outlier tracks (default true)
-        double outlierThreshold;   //!< floor of the rejection threshold, pixels RMS (default 2.5)
-        double outlierSigmas;      //!< threshold = max(floor, this * robust sigma) (default 4)
-        int maxRejectionRounds;    //!< fit / reject / refit rounds at most (default 8)
-        double depthRatio;         //!< camera t.z = this * RMS radius of the points (default 10)
+        int minTrackLength = 2;        //!< tracks seen in fewer frames are not used
+        int maxAlternations = 300;     //!< missing data: alternation iterations at most
+        double alternationTol = 1e-7;  //!< missing data: stop when RMS improves by less (rel.)
+        bool rejectOutliers = true;    //!< reject gross-outlier tracks
+        double outlierThreshold = 2.5; //!< floor of the rejection threshold, pixels RMS
+        double outlierSigmas = 4.0;    //!< threshold = max(floor, this * robust sigma)
+        int maxRejectionRounds = 8;    //!< fit / reject / refit rounds at most
+        double depthRatio = 10.0;      //!< camera t.z = this * RMS radius of the points
     };
 
     static Ptr<FactorizationSfM> create(const Params& params);

@@ -31,18 +31,17 @@ class CV_EXPORTS FeatureTracker : public Algorithm
 public:
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        int maxTracks;          //!< target number of live tracks (default 1000)
-        double quality;         //!< Shi-Tomasi quality level, relative to the best (0.01)
-        double minDistance;     //!< minimum distance between tracks, pixels (default 8)
-        int blockSize;          //!< Shi-Tomasi gradient window (default 3)
-        Size winSize;           //!< Lucas-Kanade window (default 15 x 15)
-        int levels;             //!< pyramid levels above the base (default 3)
-        double fbThreshold;     //!< forward-backward error above which a track ends, px (1.0)
-        double redetectRatio;   //!< re-detect when live tracks < this * maxTracks (0.9)
-        int minTrackLength;     //!< drop tracks seen in fewer frames (default 3)
-        int border;             //!< tracks closer than this to the image edge end, px (4)
-        Mat exclusionMask;      //!< optional CV_8U frame-size mask, > 127 = no features there
+        int maxTracks = 1000;          //!< target number of live tracks
+        double quality = 0.01;         //!< Shi-Tomasi quality level, relative to the best
+        double minDistance = 8;        //!< minimum distance between tracks, pixels
+        int blockSize = 3;             //!< Shi-Tomasi gradient window
+        Size winSize = Size(15, 15);   //!< Lucas-Kanade window
+        int levels = 3;                //!< pyramid levels above the base
+        double fbThreshold = 1.0;      //!< forward-backward error above which a track ends, px
+        double redetectRatio = 0.9;    //!< re-detect when live tracks < this * maxTracks
+        int minTrackLength = 3;        //!< drop tracks seen in fewer frames
+        int border = 4;                //!< tracks closer than this to the image edge end, px
+        Mat exclusionMask;             //!< optional CV_8U frame-size mask, > 127 = no features there
     };
 
     static Ptr<FeatureTracker> create(const Params& params);

@@ -47,43 +47,41 @@ public:
 
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
         //! Intelligent Scissors feature weights: non-edge, gradient direction, gradient
-        //! magnitude (default 0.43, 0.43, 0.14, the values of Mortensen & Barrett).
-        float weightNonEdge, weightGradientDirection, weightGradientMagnitude;
-        //! Gradient magnitude at or above which a pixel costs nothing (default 150; 0 disables).
-        float gradientMagnitudeMax;
-        //! Canny thresholds of the edge feature (default 32, 100, as in OpenCV's scissors demo).
-        double cannyLow, cannyHigh;
-        //! LIVE_WIRE clicks are moved to the strongest edge pixel within this radius (pixels,
-        //! default 2; 0 keeps the click as given).
-        int clickSnapRadius;
+        //! magnitude (the values of Mortensen & Barrett).
+        float weightNonEdge = 0.43f, weightGradientDirection = 0.43f,
+              weightGradientMagnitude = 0.14f;
+        //! Gradient magnitude at or above which a pixel costs nothing (0 disables).
+        float gradientMagnitudeMax = 150.f;
+        //! Canny thresholds of the edge feature (as in OpenCV's scissors demo).
+        double cannyLow = 32, cannyHigh = 100;
+        //! LIVE_WIRE clicks are moved to the strongest edge pixel within this radius (pixels;
+        //! 0 keeps the click as given).
+        int clickSnapRadius = 2;
         //! Live wire is searched inside the bounding box of its two anchors grown by this margin
-        //! (pixels, default 24): bounded cost, and no detour through far-away texture.
-        int searchMargin;
+        //! (pixels): bounded cost, and no detour through far-away texture.
+        int searchMargin = 24;
         //! Once a contour is closed its outside is known: live-wire pixels up to outerEdgeBand
         //! pixels inside the chord of their segment cost up to outerEdgeBias more (gradient-
         //! magnitude feature, range [0, 1]), so the wire takes the outer of two parallel edges
-        //! (a silhouette rather than a trim just inside it). Defaults 0.5 and 4; 0 disables.
-        float outerEdgeBias;
-        int outerEdgeBand;
-        //! loadMask(): tolerance of the polygon approximation of a mask outline (pixels,
-        //! default 1.0).
-        double outlineTolerance;
-        //! snapMask(): spacing of the outline samples that are snapped (pixels, default 10).
-        int snapSpacing;
-        //! snapMask(): how far along the outline normal a sample may move (pixels, default 4).
-        int snapRadius;
+        //! (a silhouette rather than a trim just inside it). 0 disables.
+        float outerEdgeBias = 0.5f;
+        int outerEdgeBand = 4;
+        //! loadMask(): tolerance of the polygon approximation of a mask outline (pixels).
+        double outlineTolerance = 1.0;
+        //! snapMask(): spacing of the outline samples that are snapped (pixels).
+        int snapSpacing = 10;
+        //! snapMask(): how far along the outline normal a sample may move (pixels).
+        int snapRadius = 4;
         //! snapMask(): preference for small moves: an edge at the full snapRadius scores this
-        //! fraction less than the same edge on the proposed outline (default 0.3).
-        float snapDistancePenalty;
-        //! Contours whose area is below this are ignored when a mask is loaded (pixels,
-        //! default 20).
-        double minContourArea;
+        //! fraction less than the same edge on the proposed outline.
+        float snapDistancePenalty = 0.3f;
+        //! Contours whose area is below this are ignored when a mask is loaded (pixels).
+        double minContourArea = 20;
         //! getMask(): a live-wire pixel on the mask's boundary is kept only when its colour is
         //! nearer to the inside neighbour's than to the outside one's (the wire runs on edge
-        //! pixels, which belong to either side). Default true.
-        bool refineBoundary;
+        //! pixels, which belong to either side).
+        bool refineBoundary = true;
     };
 
     /** @brief Creates an editor.
