@@ -18,10 +18,10 @@ namespace augocc {
 
 /** @brief The camera of the same view on a pixel grid `factor` times finer.
 
-Pixel centres follow the contract (origin at the centre of the top-left pixel): pixel (u, v) of
-the original grid covers the `factor` x `factor` block whose centres are
-`factor * (u + 0.5) - 0.5 +- ...`, so s (or fx, fy, skew) is multiplied by `factor` and the
-principal point becomes `factor * (c + 0.5) - 0.5`. Rendering with the returned camera at
+Pixel centres follow the @ref augocc_conventions_pixels "pixel conventions" (origin at the
+centre of the top-left pixel): pixel (u, v) of the original grid covers the `factor` x `factor`
+block whose centres are `factor * (u + 0.5) - 0.5 +- ...`, so s (or fx, fy, skew) is multiplied
+by `factor` and the principal point becomes `factor * (c + 0.5) - 0.5`. Rendering with the returned camera at
 `factor` times the size and box-averaging down gives an anti-aliased image of the original view.
 */
 CV_EXPORTS Camera supersampledCamera(const Camera& camera, int factor);

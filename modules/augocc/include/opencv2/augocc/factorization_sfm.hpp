@@ -43,15 +43,16 @@ Beyond the paper:
   views (Ullman; e.g. pure translation with a fixed line of sight), affine rank below 3, fewer
   than 4 usable tracks, non-finite values other than the NaN pairs of unobserved entries.
 
-Output conventions (CONTRACT.md): scaled-orthographic cameras u = s * (R X + t).x + cx with
-(cx, cy) the image centre; world origin at the centroid of the reconstructed points, world axes
-those of the first reconstructed camera (R = I), world unit chosen so that s = 1 (one world unit
-is one pixel); every camera's t.z is the same positive depth, `depthRatio` times the scene's RMS
-radius, so that depths are positive and consistent between frames (t.z does not change the image
-under orthography). Orthography leaves a depth-reversal ambiguity (the mirror image of the scene
-through the image plane, R_f -> Z R_f Z, X -> Z X with Z = diag(1, 1, -1), projects to the same
-pixels): the images do not decide it and this class returns one of the two; the perspective
-refinement (OrthoCameraRefiner::PERSPECTIVE_BA) resolves it when perspective is measurable.
+Output conventions (beyond the @ref augocc_conventions "module's"): scaled-orthographic cameras
+`u = s * (R X + t).x + cx` with (cx, cy) the image centre; world origin at the centroid of the
+reconstructed points, world axes those of the first reconstructed camera (R = I), world unit
+chosen so that s = 1 (one world unit is one pixel); every camera's t.z is the same positive
+depth, `depthRatio` times the scene's RMS radius, so that depths are positive and consistent
+between frames (t.z does not change the image under orthography). Orthography leaves a
+depth-reversal ambiguity (the mirror image of the scene through the image plane,
+R_f -> Z R_f Z, X -> Z X with Z = diag(1, 1, -1), projects to the same pixels): the images do
+not decide it and this class returns one of the two; the perspective refinement
+(OrthoCameraRefiner::PERSPECTIVE_BA) resolves it when perspective is measurable.
 */
 class CV_EXPORTS FactorizationSfM : public Algorithm
 {

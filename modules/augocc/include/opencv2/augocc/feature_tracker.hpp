@@ -41,7 +41,8 @@ public:
         double redetectRatio = 0.9;    //!< re-detect when live tracks < this * maxTracks
         int minTrackLength = 3;        //!< drop tracks seen in fewer frames
         int border = 4;                //!< tracks closer than this to the image edge end, px
-        Mat exclusionMask;             //!< optional CV_8U frame-size mask, > 127 = no features there
+        //! optional CV_8U mask of the frame size, > 127 = no features there
+        Mat exclusionMask;
     };
 
     static Ptr<FeatureTracker> create(const Params& params);

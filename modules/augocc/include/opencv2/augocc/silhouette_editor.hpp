@@ -9,14 +9,6 @@
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/camera.hpp"
 
-/*
-Silhouette tracing (the paper's Section 5): the user outlines a real object in a key frame with
-Intelligent Scissors (Mortensen & Barrett 1995, OpenCV's cv::segmentation::IntelligentScissorsMB)
-plus a straight-line tool. Pixel coordinates follow the contract: integer pixel (x, y) is the
-centre of pixel column x, row y. All the logic lives here, so that it is tested headless; the
-`augocc annotate` window only forwards clicks and keys.
-*/
-
 namespace cv {
 namespace augocc {
 
@@ -26,6 +18,12 @@ namespace augocc {
 /** @brief Contour editing for one object in one frame: anchors joined by live-wire or straight
 segments, closed contours filled into a mask, undo and redo, editing of an existing mask, and
 outlines proposed from a coarse matte snapped to the image edges.
+
+Silhouette tracing (the paper's Section 5 @cite Ong1998): the user outlines a real object in a
+key frame with Intelligent Scissors @cite Mortensen1995 (OpenCV's
+cv::segmentation::IntelligentScissorsMB) plus a straight-line tool. Points are integer pixels
+(@ref augocc_conventions_pixels "pixel conventions"). All the logic lives here, so that it is
+tested headless; the `augocc annotate` window only forwards clicks and keys.
 
 A silhouette is a set of closed contours (their filled union is the mask) plus at most one open
 contour being traced. Every contour is a cyclic list of anchors; segment i joins anchor i-1 to
