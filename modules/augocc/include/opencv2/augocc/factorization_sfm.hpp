@@ -57,22 +57,41 @@ not decide it and this class returns one of the two; the perspective refinement
 class CV_EXPORTS FactorizationSfM : public Algorithm
 {
 public:
+    //! Factorization parameters; the defaults are the initializers.
     struct CV_EXPORTS Params
     {
-        int minTrackLength = 2;        //!< tracks seen in fewer frames are not used
-        int maxAlternations = 300;     //!< missing data: alternation iterations at most
-        double alternationTol = 1e-7;  //!< missing data: stop when RMS improves by less (rel.)
-        bool rejectOutliers = true;    //!< reject gross-outlier tracks
-        double outlierThreshold = 2.5; //!< floor of the rejection threshold, pixels RMS
-        double outlierSigmas = 4.0;    //!< threshold = max(floor, this * robust sigma)
-        int maxRejectionRounds = 8;    //!< fit / reject / refit rounds at most
-        double depthRatio = 10.0;      //!< camera t.z = this * RMS radius of the points
+        //! Tracks observed in fewer frames are not used, >= 2.
+        int minTrackLength = 2;
+        //! Missing data: alternation sweeps at most, >= 0.
+        int maxAlternations = 300;
+        //! Missing data: the alternation stops when a sweep improves the RMS by less than this
+        //! fraction, >= 0 (lower iterates longer).
+        double alternationTol = 1e-7;
+        //! Reject gross-outlier tracks (false keeps every usable track).
+        bool rejectOutliers = true;
+        //! Floor of the rejection threshold, pixels RMS, > 0 (lower rejects more).
+        double outlierThreshold = 2.5;
+        //! Rejection threshold = max(outlierThreshold, this * robust sigma of the residuals),
+        //! > 0 (lower rejects more).
+        double outlierSigmas = 4.0;
+        //! Fit / reject / refit rounds at most, >= 1.
+        int maxRejectionRounds = 8;
+        //! Every camera's t.z = this * RMS radius of the points, > 0: the depth of the scene in
+        //! front of the cameras (t.z does not change the image under orthography).
+        double depthRatio = 10.0;
     };
 
+    /** @brief Creates an instance.
+    @param params factorization parameters; throws as setParams() does when they are invalid.
+    */
     static Ptr<FactorizationSfM> create(const Params& params);
     //! Creates an instance with default Params.
     static Ptr<FactorizationSfM> create();
+    //! The current parameters.
     virtual Params getParams() const = 0;
+    /** @brief Sets the parameters.
+    @param params the parameters; StsBadArg when one is outside the range its field states.
+    */
     virtual void setParams(const Params& params) = 0;
 
     /** @brief Recovers scaled-orthographic cameras and 3D points from tracks.

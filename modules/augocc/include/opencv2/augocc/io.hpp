@@ -45,7 +45,8 @@ struct CV_EXPORTS Tracks
     Point2f at(int f, int p) const { return tracks.at<Point2f>(f, p); }
     //! Number of frames in which track p is observed.
     int observationCount(int p) const;
-    //! Throws when the matrix type, the size or a value is inconsistent. @param what names the source.
+    //! Throws when the matrix type, the size or a value is inconsistent.
+    //! @param what names the source (file, key) in the message.
     void validate(const String& what = String()) const;
 };
 

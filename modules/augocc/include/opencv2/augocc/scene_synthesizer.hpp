@@ -103,7 +103,7 @@ current on the calling thread.
 class CV_EXPORTS SceneSynthesizer : public Algorithm
 {
 public:
-    /** @brief Parameters of the synthesized scene.
+    /** @brief Parameters of the synthesized scene; the defaults are the initializers.
 
     Valid ranges (setParams() throws StsBadArg/StsOutOfRange otherwise): frames >= 2, both image
     sides >= 32, distanceRatio >= 1, orbitDegrees in [0, 360], elevationDegrees in (0, 90),
@@ -111,40 +111,43 @@ public:
     frameSupersample in [1, 8]. */
     struct CV_EXPORTS Params
     {
-        //! number of frames
+        //! Number of frames.
         int frames = 60;
-        //! frame size
+        //! Frame size, pixels.
         Size imageSize = Size(640, 480);
-        //! camera model of the frames
+        //! Camera model of the frames and of the ground truth.
         CameraModel model = SCALED_ORTHOGRAPHIC;
-        //! camera distance / scene size; the framing stays the same
+        //! Camera distance / scene size; the framing stays the same (lower: stronger
+        //! perspective in PERSPECTIVE frames).
         double distanceRatio = 10.0;
-        //! azimuth swept by the camera over the sequence, degrees
+        //! Azimuth swept by the camera over the sequence, degrees.
         double orbitDegrees = 50.0;
-        //! mean elevation of the camera above the ground, degrees
+        //! Mean elevation of the camera above the ground, degrees.
         double elevationDegrees = 25.0;
-        //! tracks (3D points on the objects and ground)
+        //! Tracks (3D points on the objects and the ground).
         int numTracks = 600;
-        //! Gaussian pixel noise of `tracks`, per axis
+        //! Gaussian noise of `tracks`, pixels, standard deviation per axis.
         double noiseSigma = 0.5;
-        //! fraction of tracks that start/end mid-sequence
+        //! Fraction of tracks that start/end mid-sequence.
         double partialFraction = 0.0;
-        //! fraction of tracks that are gross outliers
+        //! Fraction of tracks that are gross outliers.
         double outlierFraction = 0.0;
-        //! key frames, evenly spaced, first and last included
+        //! Key frames, evenly spaced, first and last included.
         int numKeyFrames = 6;
-        //! random seed (textures, jitter, points, noise)
+        //! Random seed (textures, jitter, points, noise).
         uint64 seed = 1;
         /** Frames are rendered at this factor and averaged down (INTER_AREA), i.e. anti-aliased
         like a camera integrating over each pixel; masks, labels and depth are always sampled at
-        pixel centres. 1 = one sample per pixel (valid [1, 8]). */
+        pixel centres. 1 = one sample per pixel (hard, aliased edges). */
         int frameSupersample = 1;
     };
 
     //! Creates a synthesizer; throws as setParams() does on invalid parameters.
+    //! @param params scene parameters.
     static Ptr<SceneSynthesizer> create(const Params& params);
     //! Creates a synthesizer with default Params.
     static Ptr<SceneSynthesizer> create();
+    //! The current parameters.
     virtual Params getParams() const = 0;
     //! Validates and sets the parameters (see Params for the ranges).
     virtual void setParams(const Params& params) = 0;
@@ -187,7 +190,7 @@ public:
 /** @brief Writes a synthesized data set to a folder, as `augocc synth` does: frames/%04d.png,
 video.mp4 (H.264, else MPEG-4 part 2), tracks.yml, input/masks (key frames), gt/masks (whole),
 gt/visible_masks, gt/reconstruction.yml, gt/clean_tracks.yml, gt/depth (16-bit PNG, z = value /
-scale, scale in gt/depth/depth.yml, 0 = nothing), gt/labels, gt/meshes/<object>.ply and
+scale, scale in gt/depth/depth.yml, 0 = nothing), gt/labels, `gt/meshes/<object>.ply` and
 gt/synth.yml (parameters, objects, key frames, outlier flags). See doc/synthesizer.md.
 
 The folder is built under a temporary name beside `dir` and renamed into place: a failure leaves
