@@ -16,6 +16,7 @@ PACKAGES=(
     python3                               # perf comparison and contact-sheet scripts (stdlib only)
     xvfb xdotool                          # end-to-end test of the interactive annotate tool
     ffmpeg                                # ffprobe for video checks in tests
+    doxygen texlive-base                  # API docs and their test (bibtex for @cite)
 )
 
 missing=()

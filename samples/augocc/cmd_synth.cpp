@@ -17,22 +17,25 @@ namespace augocc_cli {
 
 namespace {
 
+// Flags start at the library's defaults (SceneSynthesizer::Params), which the help text shows.
+const SceneSynthesizer::Params kDefaults;
+
 struct SynthOptions
 {
     std::string out;
-    std::string model = "scaled_orthographic";
-    int frames = 60;
-    unsigned long long seed = 1;
-    double noise = 0.5;
-    double partial = 0.0;
-    double outliers = 0.0;
-    std::string size = "640x480";
-    int tracks = 600;
-    int keyFrames = -1;  // default: min(6, frames)
-    double distanceRatio = 10.0;
-    int supersample = 1;
-    double orbit = 50.0;
-    double elevation = 25.0;
+    std::string model = cameraModelName(kDefaults.model);
+    int frames = kDefaults.frames;
+    unsigned long long seed = kDefaults.seed;
+    double noise = kDefaults.noiseSigma;
+    double partial = kDefaults.partialFraction;
+    double outliers = kDefaults.outlierFraction;
+    std::string size = format("%dx%d", kDefaults.imageSize.width, kDefaults.imageSize.height);
+    int tracks = kDefaults.numTracks;
+    int keyFrames = -1;  // default: min(kDefaults.numKeyFrames, frames)
+    double distanceRatio = kDefaults.distanceRatio;
+    int supersample = kDefaults.frameSupersample;
+    double orbit = kDefaults.orbitDegrees;
+    double elevation = kDefaults.elevationDegrees;
     std::string contactSheet;
 };
 
@@ -93,7 +96,8 @@ void runSynth(const Globals& g, const SynthOptions& o)
     p.outlierFraction = o.outliers;
     p.imageSize = parseSize(o.size);
     p.numTracks = o.tracks;
-    p.numKeyFrames = o.keyFrames > 0 ? o.keyFrames : std::min(6, std::max(2, o.frames));
+    p.numKeyFrames = o.keyFrames > 0 ? o.keyFrames
+                                     : std::min(kDefaults.numKeyFrames, std::max(2, o.frames));
     p.distanceRatio = o.distanceRatio;
     p.frameSupersample = o.supersample;
     p.orbitDegrees = o.orbit;
@@ -174,7 +178,8 @@ void registerSynth(CLI::App& app, Globals& g)
     sub->add_option("--size", o->size, "frame size WIDTHxHEIGHT")->capture_default_str();
     sub->add_option("--tracks", o->tracks, "number of tracks")->capture_default_str();
     sub->add_option("--key-frames", o->keyFrames,
-                    "key frames, evenly spaced, first and last included (default min(6, frames))");
+                    format("key frames, evenly spaced, first and last included (default min(%d, "
+                           "frames))", kDefaults.numKeyFrames));
     sub->add_option("--distance-ratio", o->distanceRatio,
                     "perspective: camera distance / scene size")->capture_default_str();
     sub->add_option("--orbit", o->orbit, "azimuth swept by the camera, degrees")

@@ -10,12 +10,15 @@ namespace augocc_cli {
 
 namespace {
 
+// Flags start at the library's defaults (FeatureTracker::Params), which the help text shows.
+const cv::augocc::FeatureTracker::Params kDefaults;
+
 struct TrackArgs
 {
     std::string input, out, mask;
-    int maxTracks = 1000;
-    double fb = 1.0;
-    int minLength = 3;
+    int maxTracks = kDefaults.maxTracks;
+    double fb = kDefaults.fbThreshold;
+    int minLength = kDefaults.minTrackLength;
 };
 
 } // namespace
@@ -29,14 +32,16 @@ void registerTrack(CLI::App& app, Globals& g)
     sub->add_option("--input", args->input, "video file, image folder or printf pattern")
         ->required();
     sub->add_option("--out", args->out, "tracks.yml to write")->required();
-    sub->add_option("--max-tracks", args->maxTracks, "target number of live tracks "
-                    "(default 1000)");
+    sub->add_option("--max-tracks", args->maxTracks,
+                    cv::format("target number of live tracks (default %d)", kDefaults.maxTracks));
     sub->add_option("--mask", args->mask, "exclusion mask image (white = no features there), "
                     "the size of the frames");
-    sub->add_option("--fb-threshold", args->fb, "forward-backward error that ends a track, "
-                    "pixels (default 1.0)");
-    sub->add_option("--min-length", args->minLength, "drop tracks seen in fewer frames "
-                    "(default 3)");
+    sub->add_option("--fb-threshold", args->fb,
+                    cv::format("forward-backward error that ends a track, pixels (default %.1f)",
+                               kDefaults.fbThreshold));
+    sub->add_option("--min-length", args->minLength,
+                    cv::format("drop tracks seen in fewer frames (default %d)",
+                               kDefaults.minTrackLength));
     sub->callback([args, &g]() {
         cv::augocc::FeatureTracker::Params p;
         if (args->maxTracks < 4)

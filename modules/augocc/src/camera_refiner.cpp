@@ -50,12 +50,6 @@ ReprojectionStats computeReprojectionStats(const Reconstruction& rec, const Trac
     return st;
 }
 
-OrthoCameraRefiner::Params::Params()
-    : mode(POSITION_ZOOM), loss(LOSS_HUBER), lossScale(2.0), perFrameScale(false),
-      maxIterations(50), functionTolerance(1e-6)
-{
-}
-
 namespace {
 
 class OrthoCameraRefinerImpl CV_FINAL : public OrthoCameraRefiner

@@ -43,12 +43,6 @@ Camera supersampledCamera(const Camera& camera, int factor)
     return c;
 }
 
-Compositor::Params::Params()
-    : supersample(3), antialiasVirtual(false), cullBackFaces(true), edgeRadius(0), edgeEps(1e-2),
-      lightRotation(Matx33d::eye())
-{
-}
-
 namespace {
 
 // GL >= 1.5 entry points come from OSMesaGetProcAddress, so that they are OSMesa's whatever

@@ -314,12 +314,6 @@ using detail::AffineModel;
 using detail::ObservationIndex;
 using detail::SfmObservation;
 
-FactorizationSfM::Params::Params()
-    : minTrackLength(2), maxAlternations(300), alternationTol(1e-7), rejectOutliers(true),
-      outlierThreshold(2.5), outlierSigmas(4.0), maxRejectionRounds(8), depthRatio(10.0)
-{
-}
-
 namespace {
 
 // Moves the reconstructed points of `rec` so that their centroid is the origin; `centre` is that

@@ -11,12 +11,6 @@
 namespace cv {
 namespace augocc {
 
-FeatureTracker::Params::Params()
-    : maxTracks(1000), quality(0.01), minDistance(8), blockSize(3), winSize(15, 15), levels(3),
-      fbThreshold(1.0), redetectRatio(0.9), minTrackLength(3), border(4)
-{
-}
-
 namespace {
 
 // Pyramid levels above the base searched by Lucas-Kanade for a track with a velocity (around its

@@ -53,8 +53,8 @@ const int kMinResectInliers = 6;
 // ... and at least this fraction of the points it sees must agree with the pose.
 const double kMinResectInlierFraction = 0.5;
 // Robust (Huber) scale of the resection and of the bundle adjustments, pixels: the refiner's
-// default lossScale (OrthoCameraRefiner::Params).
-const double kHuberPx = 2.0;
+// default lossScale.
+const double kHuberPx = OrthoCameraRefiner::Params().lossScale;
 // Frames adjusted after each resection: the newest few (their points' other frames fixed).
 const int kLocalWindow = 6;
 // A global adjustment and a rejection round each time the reconstructed frames grew by this

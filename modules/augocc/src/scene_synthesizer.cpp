@@ -19,13 +19,6 @@
 namespace cv {
 namespace augocc {
 
-SceneSynthesizer::Params::Params()
-    : frames(60), imageSize(640, 480), model(SCALED_ORTHOGRAPHIC), distanceRatio(10.0),
-      orbitDegrees(50.0), elevationDegrees(25.0), numTracks(600), noiseSigma(0.5),
-      partialFraction(0.0), outlierFraction(0.0), numKeyFrames(6), seed(1), frameSupersample(1)
-{
-}
-
 namespace {
 
 const double kPi = 3.14159265358979323846;

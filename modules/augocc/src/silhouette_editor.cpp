@@ -9,15 +9,6 @@
 namespace cv {
 namespace augocc {
 
-SilhouetteEditor::Params::Params()
-    : weightNonEdge(0.43f), weightGradientDirection(0.43f), weightGradientMagnitude(0.14f),
-      gradientMagnitudeMax(150.f), cannyLow(32), cannyHigh(100), clickSnapRadius(2),
-      searchMargin(24), outerEdgeBias(0.5f), outerEdgeBand(4), outlineTolerance(1.0),
-      snapSpacing(10), snapRadius(4), snapDistancePenalty(0.3f), minContourArea(20),
-      refineBoundary(true)
-{
-}
-
 namespace {
 
 // A segment joins the previous anchor to its own anchor; `path` holds every pixel of it, both

@@ -6,26 +6,17 @@
 
 #include <opencv2/core.hpp>
 
-/*
-Conventions (CONTRACT.md), stated once for the whole module:
-- World-to-camera: Xc = R * Xw + t, R a rotation. The camera looks along +z, image x right, y down.
-- Depth of a point is Xc.z (larger = farther) in every camera model.
-- Image coordinates are pixels, origin at the CENTRE of the top-left pixel.
-- SCALED_ORTHOGRAPHIC: u = s * Xc.x + cx, v = s * Xc.y + cy (s = pixels per world unit).
-- PERSPECTIVE: (u, v, 1)^T ~ K * Xc (OpenCV pinhole, no distortion).
-*/
-
 namespace cv {
 namespace augocc {
 
 //! @addtogroup augocc
 //! @{
 
-//! Camera models of the contract.
+//! Camera models (@ref augocc_conventions_camera "conventions").
 enum CameraModel
 {
-    SCALED_ORTHOGRAPHIC = 0, //!< the paper's model: u = s * Xc.x + cx
-    PERSPECTIVE = 1          //!< pinhole: u = fx * Xc.x / Xc.z + cx
+    SCALED_ORTHOGRAPHIC = 0, //!< the paper's model: u = s * Xc.x + cx, v = s * Xc.y + cy
+    PERSPECTIVE = 1          //!< pinhole: u = fx * Xc.x / Xc.z + cx, v = fy * Xc.y / Xc.z + cy
 };
 
 //! @brief Contract name of a camera model ("scaled_orthographic", "perspective").
@@ -36,8 +27,8 @@ CV_EXPORTS CameraModel parseCameraModel(const String& name);
 //! A ray in world coordinates: origin + lambda * direction, direction of unit length.
 struct CV_EXPORTS Ray
 {
-    Vec3d origin;
-    Vec3d direction;
+    Vec3d origin;     //!< world point at lambda = 0
+    Vec3d direction;  //!< unit direction, world coordinates
     //! Point at parameter lambda.
     Vec3d at(double lambda) const { return origin + lambda * direction; }
 };
@@ -46,16 +37,18 @@ struct CV_EXPORTS Ray
 
 The single place where projection, back-projection and depth are defined; every algorithm of
 the module uses it instead of re-deriving a projection.
+@sa @ref augocc_conventions_camera "Camera conventions"
 */
 struct CV_EXPORTS Camera
 {
-    CameraModel model = SCALED_ORTHOGRAPHIC;
+    CameraModel model = SCALED_ORTHOGRAPHIC;  //!< projection model
     int frame = 0;                 //!< 0-based frame index in the input sequence
-    Matx33d R = Matx33d::eye();    //!< rotation, world to camera
-    Vec3d t = Vec3d(0, 0, 0);      //!< translation, world to camera
-    double s = 1.0;                //!< SCALED_ORTHOGRAPHIC: pixels per world unit
-    Matx33d K = Matx33d::eye();    //!< PERSPECTIVE: intrinsics
-    Point2d pp = Point2d(0, 0);    //!< SCALED_ORTHOGRAPHIC: principal point (PERSPECTIVE: in K)
+    Matx33d R = Matx33d::eye();    //!< rotation, world to camera: Xc = R * Xw + t
+    Vec3d t = Vec3d(0, 0, 0);      //!< translation, world to camera: Xc = R * Xw + t
+    double s = 1.0;                //!< SCALED_ORTHOGRAPHIC: zoom, pixels per world unit
+    Matx33d K = Matx33d::eye();    //!< PERSPECTIVE: intrinsics (fx, skew, cx; 0, fy, cy; 0, 0, 1)
+    //! SCALED_ORTHOGRAPHIC: principal point (cx, cy), pixels (PERSPECTIVE: in K)
+    Point2d pp = Point2d(0, 0);
 
     //! Makes a scaled-orthographic camera.
     static Camera orthographic(const Matx33d& R, const Vec3d& t, double s, const Point2d& pp,
@@ -68,7 +61,10 @@ struct CV_EXPORTS Camera
     //! World point to camera coordinates.
     Vec3d toCamera(const Vec3d& Xw) const { return R * Xw + t; }
     //! Camera-space depth Xc.z of a world point.
-    double depth(const Vec3d& Xw) const { return R(2, 0) * Xw[0] + R(2, 1) * Xw[1] + R(2, 2) * Xw[2] + t[2]; }
+    double depth(const Vec3d& Xw) const
+    {
+        return R(2, 0) * Xw[0] + R(2, 1) * Xw[1] + R(2, 2) * Xw[2] + t[2];
+    }
     //! Projects a camera-space point to pixels.
     Point2d projectCamera(const Vec3d& Xc) const;
     //! Projects a world point to pixels.

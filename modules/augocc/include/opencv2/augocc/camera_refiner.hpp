@@ -60,12 +60,14 @@ Ceres runs with num_threads = cv::getNumThreads().
 class CV_EXPORTS OrthoCameraRefiner : public Algorithm
 {
 public:
+    //! What is refined (see the class description).
     enum Mode
     {
         POSITION_ZOOM = 0,  //!< the paper's 3F+1 LM: positions and one zoom
         FULL_BA = 1,        //!< scaled-orthographic bundle adjustment
         PERSPECTIVE_BA = 2  //!< perspective bundle adjustment from the affine solution
     };
+    //! Robust loss of the bundle adjustments.
     enum Loss
     {
         LOSS_NONE = 0,      //!< plain least squares
@@ -73,21 +75,37 @@ public:
         LOSS_CAUCHY = 2     //!< ceres::CauchyLoss(lossScale)
     };
 
+    //! Refinement parameters; the defaults are the initializers.
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        int mode;                //!< Mode (default POSITION_ZOOM)
-        int loss;                //!< Loss for FULL_BA and PERSPECTIVE_BA (default LOSS_HUBER)
-        double lossScale;        //!< pixels at which the robust loss bends (default 2.0)
-        bool perFrameScale;      //!< FULL_BA: one zoom per frame instead of one (default false)
-        int maxIterations;       //!< Levenberg-Marquardt iterations at most (default 50)
-        double functionTolerance;//!< Ceres function_tolerance (default 1e-6)
+        //! Mode; the default is the paper's.
+        int mode = POSITION_ZOOM;
+        //! Loss of FULL_BA and PERSPECTIVE_BA (POSITION_ZOOM is plain least squares).
+        int loss = LOSS_HUBER;
+        //! Residual at which the robust loss bends, pixels, > 0 (lower down-weights more
+        //! observations).
+        double lossScale = 2.0;
+        //! FULL_BA: one zoom per frame (weak perspective) instead of one for the sequence.
+        bool perFrameScale = false;
+        //! Levenberg-Marquardt iterations at most, >= 1.
+        int maxIterations = 50;
+        //! Ceres function_tolerance: stop when the cost changes by less than this fraction,
+        //! > 0 (lower iterates longer).
+        double functionTolerance = 1e-6;
     };
 
+    /** @brief Creates an instance.
+    @param params refinement parameters; throws as setParams() does when they are invalid.
+    */
     static Ptr<OrthoCameraRefiner> create(const Params& params);
     //! Creates an instance with default Params (the paper's 3F+1).
     static Ptr<OrthoCameraRefiner> create();
+    //! The current parameters.
     virtual Params getParams() const = 0;
+    /** @brief Sets the parameters.
+    @param params the parameters; StsBadArg on an unknown mode or loss, or a value outside the
+    range its field states.
+    */
     virtual void setParams(const Params& params) = 0;
 
     /** @brief Refines a reconstruction in place.
@@ -113,8 +131,9 @@ struct CV_EXPORTS SfmOptions
     the image changes as the camera moves closer or farther); false keeps the paper's single
     zoom. Overrides refiner.perFrameScale. */
     bool perFrameScale = true;
-    double autoRatio = 0.9;        //!< `auto`: the RMS ratio below which perspective is kept
-    FactorizationSfM::Params factorization;
+    //! `auto`: the RMS ratio below which perspective is kept (higher keeps it more often)
+    double autoRatio = 0.9;
+    FactorizationSfM::Params factorization;  //!< settings of the factorization stage
     OrthoCameraRefiner::Params refiner;  //!< loss and iteration settings shared by the stages
 };
 

@@ -18,11 +18,12 @@ namespace augocc {
 
 /** @brief The camera of the same view on a pixel grid `factor` times finer.
 
-Pixel centres follow the contract (origin at the centre of the top-left pixel): pixel (u, v) of
-the original grid covers the `factor` x `factor` block whose centres are
-`factor * (u + 0.5) - 0.5 +- ...`, so s (or fx, fy, skew) is multiplied by `factor` and the
-principal point becomes `factor * (c + 0.5) - 0.5`. Rendering with the returned camera at
-`factor` times the size and box-averaging down gives an anti-aliased image of the original view.
+Pixel centres follow the @ref augocc_conventions_pixels "pixel conventions" (origin at the
+centre of the top-left pixel): pixel (u, v) of the original grid covers the `factor` x `factor`
+block whose centres are `factor * (u + 0.5) - 0.5 +- ...`, so s (or fx, fy, skew) is multiplied
+by `factor` and the principal point becomes `factor * (c + 0.5) - 0.5`. Rendering with the
+returned camera at `factor` times the size and box-averaging down gives an anti-aliased image of
+the original view.
 */
 CV_EXPORTS Camera supersampledCamera(const Camera& camera, int factor);
 
@@ -47,44 +48,53 @@ thread); it is not itself parallel, but its CPU stages use cv::parallel_for_.
 class CV_EXPORTS Compositor : public Algorithm
 {
 public:
+    //! Compositing parameters; the defaults are the initializers.
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        /** Supersampling factor of the depth test against the real objects (default 3): the
-        occluder depth is sampled k x k per pixel. 1 gives the paper's hard depth test; 3 makes
-        occlusion edges soft (see doc/compositor.md for the measured error). */
-        int supersample;
-        /** With supersample k > 1: also render the virtual objects at k x (anti-aliases their
-        own outlines against the frame, at k^2 the rasterising cost). Default false: the virtual
-        layer is rendered at the frame's resolution and only the depth test against the real
-        objects runs at k x k samples per pixel (each against the pixel's virtual depth), which
-        is what makes occlusion edges soft (doc/compositor.md: same edge error, 2.3x faster). */
-        bool antialiasVirtual;
+        /** Supersampling factor k of the depth test against the real objects, in [1, 8]: the
+        occluder depth is sampled k x k per pixel. 1 is the paper's hard depth test; higher
+        resolves the coverage of a pixel at an occlusion edge more finely, at k^2 the occluder
+        samples (the edge error is measured in doc/compositor.md). */
+        int supersample = 3;
+        /** With supersample k > 1, also render the virtual objects at k x: anti-aliases their
+        own outlines against the frame, at k^2 the rasterising cost. Off, the virtual layer is
+        rendered at the frame's resolution and only the depth test against the real objects
+        runs at k x k samples per pixel (each against the pixel's virtual depth), which is what
+        makes occlusion edges soft: the same edge error for a fraction of the time
+        (doc/compositor.md). */
+        bool antialiasVirtual = false;
         /** Cull the back faces of meshes that are closed and outward-oriented (checked per mesh
-        when uploaded; such back faces are never visible, so no pixel changes). Halves the
-        triangles the rasteriser sets up (default true). */
-        bool cullBackFaces;
+        when uploaded; such back faces are never visible, so no pixel changes): halves the
+        triangles the rasteriser sets up. */
+        bool cullBackFaces = true;
         /** Optional occlusion-edge refinement: radius in frame pixels of a guided filter
         (cv::ximgproc::guidedFilter, guided by the frame) that re-estimates the visible fraction
         of the virtual objects around the occlusion boundary, so that it follows the real
-        object's edge in the image. Default 0 (off): on richly textured real objects the filter
-        follows the texture and measured worse than the supersampled depth test alone
-        (doc/compositor.md); it helps on plain objects with clean edges. */
-        int edgeRadius;
-        //! Regularisation of that guided filter, guide in [0, 1] (default 1e-2).
-        double edgeEps;
+        object's edge in the image; in [0, 16], 0 = off. Off by default: on richly textured
+        real objects the filter follows the texture and measured worse than the supersampled
+        depth test alone (doc/compositor.md); it helps on plain objects with clean edges. */
+        int edgeRadius = 0;
+        //! Regularisation of that guided filter, guide in [0, 1], > 0 (higher smooths more,
+        //! follows the frame's edges less).
+        double edgeEps = 1e-2;
         /** Rotation from the world of the reconstruction to the shading frame (y up) in which
-        the light of the shading convention is fixed (default identity: the world is y up, as
-        the synthesizer's). For a reconstruction, use the rows (right, up, back) of its
+        the light of the shading convention is fixed; identity: the world is y up, as the
+        synthesizer's. For a reconstruction, use the rows (right, up, back) of its
         estimateGround() frame, so that the sun shines from above whatever the world's axes. */
-        Matx33d lightRotation;
+        Matx33d lightRotation = Matx33d::eye();
     };
 
+    /** @brief Creates a compositor (the OpenGL context is made on first use).
+    @param params compositing parameters; throws as setParams() does when they are invalid.
+    */
     static Ptr<Compositor> create(const Params& params);
     //! Creates a compositor with default Params.
     static Ptr<Compositor> create();
+    //! The current parameters.
     virtual Params getParams() const = 0;
-    //! Throws StsBadArg on supersample < 1 or > 8.
+    /** @brief Sets the parameters.
+    @param params the parameters; StsBadArg when one is outside the range its field states.
+    */
     virtual void setParams(const Params& params) = 0;
 
     /** @brief Sets the virtual objects, in the world frame of the reconstruction. The meshes are

@@ -43,36 +43,55 @@ Beyond the paper:
   views (Ullman; e.g. pure translation with a fixed line of sight), affine rank below 3, fewer
   than 4 usable tracks, non-finite values other than the NaN pairs of unobserved entries.
 
-Output conventions (CONTRACT.md): scaled-orthographic cameras u = s * (R X + t).x + cx with
-(cx, cy) the image centre; world origin at the centroid of the reconstructed points, world axes
-those of the first reconstructed camera (R = I), world unit chosen so that s = 1 (one world unit
-is one pixel); every camera's t.z is the same positive depth, `depthRatio` times the scene's RMS
-radius, so that depths are positive and consistent between frames (t.z does not change the image
-under orthography). Orthography leaves a depth-reversal ambiguity (the mirror image of the scene
-through the image plane, R_f -> Z R_f Z, X -> Z X with Z = diag(1, 1, -1), projects to the same
-pixels): the images do not decide it and this class returns one of the two; the perspective
-refinement (OrthoCameraRefiner::PERSPECTIVE_BA) resolves it when perspective is measurable.
+Output conventions (beyond the @ref augocc_conventions "module's"): scaled-orthographic cameras
+`u = s * (R X + t).x + cx` with (cx, cy) the image centre; world origin at the centroid of the
+reconstructed points, world axes those of the first reconstructed camera (R = I), world unit
+chosen so that s = 1 (one world unit is one pixel); every camera's t.z is the same positive
+depth, `depthRatio` times the scene's RMS radius, so that depths are positive and consistent
+between frames (t.z does not change the image under orthography). Orthography leaves a
+depth-reversal ambiguity (the mirror image of the scene through the image plane,
+R_f -> Z R_f Z, X -> Z X with Z = diag(1, 1, -1), projects to the same pixels): the images do
+not decide it and this class returns one of the two; the perspective refinement
+(OrthoCameraRefiner::PERSPECTIVE_BA) resolves it when perspective is measurable.
 */
 class CV_EXPORTS FactorizationSfM : public Algorithm
 {
 public:
+    //! Factorization parameters; the defaults are the initializers.
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        int minTrackLength;        //!< tracks seen in fewer frames are not used (default 2)
-        int maxAlternations;       //!< missing data: alternation iterations at most (default 300)
-        double alternationTol;     //!< missing data: stop when RMS improves by less (rel.) (1e-7)
-        bool rejectOutliers;       //!< reject gross-outlier tracks (default true)
-        double outlierThreshold;   //!< floor of the rejection threshold, pixels RMS (default 2.5)
-        double outlierSigmas;      //!< threshold = max(floor, this * robust sigma) (default 4)
-        int maxRejectionRounds;    //!< fit / reject / refit rounds at most (default 8)
-        double depthRatio;         //!< camera t.z = this * RMS radius of the points (default 10)
+        //! Tracks observed in fewer frames are not used, >= 2.
+        int minTrackLength = 2;
+        //! Missing data: alternation sweeps at most, >= 0.
+        int maxAlternations = 300;
+        //! Missing data: the alternation stops when a sweep improves the RMS by less than this
+        //! fraction, >= 0 (lower iterates longer).
+        double alternationTol = 1e-7;
+        //! Reject gross-outlier tracks (false keeps every usable track).
+        bool rejectOutliers = true;
+        //! Floor of the rejection threshold, pixels RMS, > 0 (lower rejects more).
+        double outlierThreshold = 2.5;
+        //! Rejection threshold = max(outlierThreshold, this * robust sigma of the residuals),
+        //! > 0 (lower rejects more).
+        double outlierSigmas = 4.0;
+        //! Fit / reject / refit rounds at most, >= 1.
+        int maxRejectionRounds = 8;
+        //! Every camera's t.z = this * RMS radius of the points, > 0: the depth of the scene in
+        //! front of the cameras (t.z does not change the image under orthography).
+        double depthRatio = 10.0;
     };
 
+    /** @brief Creates an instance.
+    @param params factorization parameters; throws as setParams() does when they are invalid.
+    */
     static Ptr<FactorizationSfM> create(const Params& params);
     //! Creates an instance with default Params.
     static Ptr<FactorizationSfM> create();
+    //! The current parameters.
     virtual Params getParams() const = 0;
+    /** @brief Sets the parameters.
+    @param params the parameters; StsBadArg when one is outside the range its field states.
+    */
     virtual void setParams(const Params& params) = 0;
 
     /** @brief Recovers scaled-orthographic cameras and 3D points from tracks.

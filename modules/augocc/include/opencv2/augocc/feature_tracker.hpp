@@ -29,26 +29,47 @@ not depend on the number of threads.
 class CV_EXPORTS FeatureTracker : public Algorithm
 {
 public:
+    //! Tracking parameters; the defaults are the initializers.
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        int maxTracks;          //!< target number of live tracks (default 1000)
-        double quality;         //!< Shi-Tomasi quality level, relative to the best (0.01)
-        double minDistance;     //!< minimum distance between tracks, pixels (default 8)
-        int blockSize;          //!< Shi-Tomasi gradient window (default 3)
-        Size winSize;           //!< Lucas-Kanade window (default 15 x 15)
-        int levels;             //!< pyramid levels above the base (default 3)
-        double fbThreshold;     //!< forward-backward error above which a track ends, px (1.0)
-        double redetectRatio;   //!< re-detect when live tracks < this * maxTracks (0.9)
-        int minTrackLength;     //!< drop tracks seen in fewer frames (default 3)
-        int border;             //!< tracks closer than this to the image edge end, px (4)
-        Mat exclusionMask;      //!< optional CV_8U frame-size mask, > 127 = no features there
+        //! Target number of live tracks, >= 4 (more: denser tracks, slower).
+        int maxTracks = 1000;
+        //! Shi-Tomasi quality level, a fraction in (0, 1) of the strongest corner's response
+        //! (lower accepts weaker corners).
+        double quality = 0.01;
+        //! Minimum distance between tracks, pixels, >= 0 (lower packs them closer).
+        double minDistance = 8;
+        //! Shi-Tomasi gradient window, pixels, >= 3.
+        int blockSize = 3;
+        //! Lucas-Kanade window, pixels, at least 5 x 5 (larger follows larger motion, smooths
+        //! over detail).
+        Size winSize = Size(15, 15);
+        //! Pyramid levels above the base, 0..8 (more: larger motion between frames).
+        int levels = 3;
+        //! Forward-backward error above which a track ends, pixels, > 0 (lower ends more tracks).
+        double fbThreshold = 1.0;
+        //! Re-detect corners when fewer than this * maxTracks tracks are alive, in (0, 1]
+        //! (higher re-detects more often).
+        double redetectRatio = 0.9;
+        //! Tracks observed in fewer frames are dropped, >= 1.
+        int minTrackLength = 3;
+        //! Tracks closer than this to the image edge end, pixels, >= 0.
+        int border = 4;
+        //! Optional CV_8U mask of the frame size, > 127 = no features there.
+        Mat exclusionMask;
     };
 
+    /** @brief Creates a tracker.
+    @param params tracking parameters; throws as setParams() does when they are invalid.
+    */
     static Ptr<FeatureTracker> create(const Params& params);
     //! Creates a tracker with default Params.
     static Ptr<FeatureTracker> create();
+    //! The current parameters.
     virtual Params getParams() const = 0;
+    /** @brief Sets the parameters.
+    @param params the parameters; StsBadArg when one is outside the range its field states.
+    */
     virtual void setParams(const Params& params) = 0;
 
     /** @brief Tracks features through in-memory frames.

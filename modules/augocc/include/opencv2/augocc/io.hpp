@@ -11,9 +11,10 @@
 #include "opencv2/augocc/camera.hpp"
 
 /*
-The interchange contract (../shared/CONTRACT.md): tracks.yml, reconstruction.yml, masks and mattes
-folders, and frame sequences given as a video, an image folder or a printf pattern. Algorithms never
-parse files; they take these types. Every reader validates and throws cv::Exception (StsBadArg,
+The interchange files (tracks.yml, reconstruction.yml, masks and mattes folders; README.md,
+"Files") and frame sequences given as a video, an image folder or a printf pattern; conventions
+in the augocc group (opencv2/augocc.hpp, @ref augocc_conventions). Algorithms never parse files;
+they take these types. Every reader validates and throws cv::Exception (StsBadArg,
 StsParseError, StsBadSize, StsObjectNotFound) with a message that names the file and the key.
 Every writer writes to a temporary name and renames, so a failure leaves no partial file.
 */
@@ -27,13 +28,16 @@ namespace augocc {
 /** @brief 2D feature tracks: the measurement matrix of the factorization.
 
 `tracks` is F x P CV_32FC2, (u, v) of track p in frame f, both NaN where not observed.
+@sa @ref augocc_conventions_units "Units and indices"
 */
 struct CV_EXPORTS Tracks
 {
-    Size imageSize;
-    Mat tracks;
+    Size imageSize;  //!< size of the frames, pixels
+    Mat tracks;      //!< F x P CV_32FC2: (u, v) of track p in frame f, pixels; NaN: not observed
 
+    //! Number of frames F (rows of `tracks`).
     int frames() const { return tracks.rows; }
+    //! Number of tracks P (columns of `tracks`).
     int points() const { return tracks.cols; }
     //! True when track p is observed (finite) in frame f.
     bool observed(int f, int p) const;
@@ -41,7 +45,8 @@ struct CV_EXPORTS Tracks
     Point2f at(int f, int p) const { return tracks.at<Point2f>(f, p); }
     //! Number of frames in which track p is observed.
     int observationCount(int p) const;
-    //! Throws when the matrix type, the size or a value is inconsistent. @param what names the source.
+    //! Throws when the matrix type, the size or a value is inconsistent.
+    //! @param what names the source (file, key) in the message.
     void validate(const String& what = String()) const;
 };
 
@@ -49,8 +54,8 @@ struct CV_EXPORTS Tracks
 a row of NaN is a rejected or unreconstructed track. */
 struct CV_EXPORTS Reconstruction
 {
-    CameraModel model = SCALED_ORTHOGRAPHIC;
-    Size imageSize;
+    CameraModel model = SCALED_ORTHOGRAPHIC;  //!< model of every camera
+    Size imageSize;               //!< size of the frames, pixels
     std::vector<Camera> cameras;  //!< any subset of frames, in increasing frame order
     Mat points;                   //!< P x 3 CV_64F (may be empty)
 

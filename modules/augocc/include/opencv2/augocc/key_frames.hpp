@@ -53,7 +53,8 @@ empty = every track.
 @return F x F CV_64F; two frames that both observe none of the tracks have change 0.
 */
 CV_EXPORTS Mat visibilityChangeMatrix(const Tracks& tracks,
-                                      const std::vector<uchar>& objectTracks = std::vector<uchar>());
+                                      const std::vector<uchar>& objectTracks =
+                                          std::vector<uchar>());
 
 /** @brief The tracks that belong to an object, from its silhouettes in some frames.
 
@@ -95,7 +96,8 @@ degreesPerChange, visibility change of the object's tracks).
 @param count number of key frames wanted (first and last camera frames included).
 @param objectMasks optional silhouettes of the object in some frames: restricts the visibility
 change to its tracks (objectTracksFromMasks()); empty = every track.
-@param degreesPerChange turn of the view direction that counts as a complete change (> 0).
+@param degreesPerChange turn of the view direction that counts as a complete change, degrees,
+> 0 (lower gives the view change more weight against the visibility change).
 @return frame indices, sorted.
 */
 CV_EXPORTS std::vector<int> suggestKeyFrames(const Tracks& tracks, const Reconstruction& rec,

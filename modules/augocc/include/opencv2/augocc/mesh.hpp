@@ -29,13 +29,14 @@ counter-clockwise seen from outside (right-handed), normals point outwards.
 */
 struct CV_EXPORTS Mesh
 {
-    std::vector<Vec3f> vertices;
+    std::vector<Vec3f> vertices;    //!< vertex positions
     std::vector<Vec3i> faces;       //!< vertex indices, three per triangle
     std::vector<Vec3f> normals;     //!< optional per-vertex normals
     std::vector<Vec2f> texcoords;   //!< optional per-vertex texture coordinates (u right, v up)
     std::vector<Vec3f> colors;      //!< optional per-vertex RGB colours in [0, 1]
-    Material material;
+    Material material;              //!< appearance of the whole mesh
 
+    //! True when the mesh has no triangle.
     bool empty() const { return faces.empty(); }
     //! Applies a 4x4 similarity/affine transform to vertices (and normals, re-normalised).
     void transform(const Matx44d& M);
@@ -43,7 +44,8 @@ struct CV_EXPORTS Mesh
     void computeNormals();
     //! Axis-aligned bounds; throws if the mesh has no vertex.
     void bounds(Vec3f& minCorner, Vec3f& maxCorner) const;
-    //! Appends another mesh (its material is dropped; per-vertex arrays are kept only when both have them).
+    //! Appends another mesh (its material is dropped; per-vertex arrays are kept only when both
+    //! have them).
     void append(const Mesh& other);
 
     //! Axis-aligned box between two corners (flat normals, per-face texture coordinates).
@@ -58,9 +60,9 @@ struct CV_EXPORTS Mesh
     static Mesh dome(float radius, int segments = 32, int rings = 12);
 };
 
-/** @brief Writes a mesh as binary little-endian PLY (vertices, faces, per-vertex colours and normals
-when present). A mesh with no faces is written as a point cloud, an empty mesh as a valid PLY
-with no element. Atomic (temporary + rename). */
+/** @brief Writes a mesh as binary little-endian PLY (vertices, faces, per-vertex colours and
+normals when present). A mesh with no faces is written as a point cloud, an empty mesh as a valid
+PLY with no element. Atomic (temporary + rename). */
 CV_EXPORTS void writeMeshPly(const String& path, const Mesh& mesh);
 
 /** @brief Loads every mesh of a file through Assimp (OBJ, PLY, glTF/GLB, and the other formats

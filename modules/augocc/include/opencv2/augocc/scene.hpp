@@ -39,9 +39,9 @@ struct CV_EXPORTS SceneObject
         PLACE_IN_FRONT = 3    //!< `in_front_of: <clone>`
     };
 
-    String name;                         //!< object name (default object_<i>)
+    String name;                         //!< object name (default `object_<i>`)
     String shape;                        //!< procedural shape (dome, tree, box...) or empty
-    String meshFile;                     //!< mesh file (resolved against the scene's folder) or empty
+    String meshFile;                     //!< mesh file (relative to the scene's folder) or empty
     std::vector<Mesh> meshes;            //!< loaded geometry, object coordinates
     int placement = PLACE_ABSOLUTE;      //!< Placement
     Vec3d position = Vec3d(0, 0, 0);     //!< PLACE_ABSOLUTE: world position of the object origin
@@ -58,7 +58,7 @@ struct CV_EXPORTS SceneObject
 struct CV_EXPORTS VirtualScene
 {
     String path;                        //!< the file it came from
-    std::vector<SceneObject> objects;
+    std::vector<SceneObject> objects;   //!< the objects, in file order
 };
 
 /** @brief Reads and validates a scene file; loads its meshes (files relative to the scene file's

@@ -103,48 +103,51 @@ current on the calling thread.
 class CV_EXPORTS SceneSynthesizer : public Algorithm
 {
 public:
+    /** @brief Parameters of the synthesized scene; the defaults are the initializers.
+
+    Valid ranges (setParams() throws StsBadArg/StsOutOfRange otherwise): frames >= 2, both image
+    sides >= 32, distanceRatio >= 1, orbitDegrees in [0, 360], elevationDegrees in (0, 90),
+    numTracks >= 1, noiseSigma >= 0, both fractions in [0, 1], numKeyFrames in [2, frames],
+    frameSupersample in [1, 8]. */
     struct CV_EXPORTS Params
     {
-        /** Defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg).
-        Valid ranges (setParams() throws StsBadArg/StsOutOfRange otherwise): frames >= 2, both image
-        sides >= 32, distanceRatio >= 1, orbitDegrees in [0, 360], elevationDegrees in (0, 90),
-        numTracks >= 1, noiseSigma >= 0, both fractions in [0, 1],
-        numKeyFrames in [2, frames], frameSupersample in [1, 8]. */
-        Params();
-        //! number of frames (default 60)
-        int frames;
-        //! frame size (default 640x480)
-        Size imageSize;
-        //! camera model of the frames (default SCALED_ORTHOGRAPHIC)
-        CameraModel model;
-        //! camera distance / scene size (default 10); the framing stays the same
-        double distanceRatio;
-        //! azimuth swept by the camera over the sequence, degrees (default 50)
-        double orbitDegrees;
-        //! mean elevation of the camera above the ground, degrees (default 25)
-        double elevationDegrees;
-        //! tracks (3D points on the objects and ground) (default 600)
-        int numTracks;
-        //! Gaussian pixel noise of `tracks`, per axis (default 0.5)
-        double noiseSigma;
-        //! fraction of tracks that start/end mid-sequence (default 0)
-        double partialFraction;
-        //! fraction of tracks that are gross outliers (default 0)
-        double outlierFraction;
-        //! key frames, evenly spaced, first and last included (default 6)
-        int numKeyFrames;
-        //! random seed (textures, jitter, points, noise) (default 1)
-        uint64 seed;
+        //! Number of frames.
+        int frames = 60;
+        //! Frame size, pixels.
+        Size imageSize = Size(640, 480);
+        //! Camera model of the frames and of the ground truth.
+        CameraModel model = SCALED_ORTHOGRAPHIC;
+        //! Camera distance / scene size; the framing stays the same (lower: stronger
+        //! perspective in PERSPECTIVE frames).
+        double distanceRatio = 10.0;
+        //! Azimuth swept by the camera over the sequence, degrees.
+        double orbitDegrees = 50.0;
+        //! Mean elevation of the camera above the ground, degrees.
+        double elevationDegrees = 25.0;
+        //! Tracks (3D points on the objects and the ground).
+        int numTracks = 600;
+        //! Gaussian noise of `tracks`, pixels, standard deviation per axis.
+        double noiseSigma = 0.5;
+        //! Fraction of tracks that start/end mid-sequence.
+        double partialFraction = 0.0;
+        //! Fraction of tracks that are gross outliers.
+        double outlierFraction = 0.0;
+        //! Key frames, evenly spaced, first and last included.
+        int numKeyFrames = 6;
+        //! Random seed (textures, jitter, points, noise).
+        uint64 seed = 1;
         /** Frames are rendered at this factor and averaged down (INTER_AREA), i.e. anti-aliased
         like a camera integrating over each pixel; masks, labels and depth are always sampled at
-        pixel centres. 1 = one sample per pixel (default 1, valid [1, 8]). */
-        int frameSupersample;
+        pixel centres. 1 = one sample per pixel (hard, aliased edges). */
+        int frameSupersample = 1;
     };
 
     //! Creates a synthesizer; throws as setParams() does on invalid parameters.
+    //! @param params scene parameters.
     static Ptr<SceneSynthesizer> create(const Params& params);
     //! Creates a synthesizer with default Params.
     static Ptr<SceneSynthesizer> create();
+    //! The current parameters.
     virtual Params getParams() const = 0;
     //! Validates and sets the parameters (see Params for the ranges).
     virtual void setParams(const Params& params) = 0;
@@ -187,7 +190,7 @@ public:
 /** @brief Writes a synthesized data set to a folder, as `augocc synth` does: frames/%04d.png,
 video.mp4 (H.264, else MPEG-4 part 2), tracks.yml, input/masks (key frames), gt/masks (whole),
 gt/visible_masks, gt/reconstruction.yml, gt/clean_tracks.yml, gt/depth (16-bit PNG, z = value /
-scale, scale in gt/depth/depth.yml, 0 = nothing), gt/labels, gt/meshes/<object>.ply and
+scale, scale in gt/depth/depth.yml, 0 = nothing), gt/labels, `gt/meshes/<object>.ply` and
 gt/synth.yml (parameters, objects, key frames, outlier flags). See doc/synthesizer.md.
 
 The folder is built under a temporary name beside `dir` and renamed into place: a failure leaves

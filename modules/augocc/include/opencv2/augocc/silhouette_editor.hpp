@@ -9,14 +9,6 @@
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/camera.hpp"
 
-/*
-Silhouette tracing (the paper's Section 5): the user outlines a real object in a key frame with
-Intelligent Scissors (Mortensen & Barrett 1995, OpenCV's cv::segmentation::IntelligentScissorsMB)
-plus a straight-line tool. Pixel coordinates follow the contract: integer pixel (x, y) is the
-centre of pixel column x, row y. All the logic lives here, so that it is tested headless; the
-`augocc annotate` window only forwards clicks and keys.
-*/
-
 namespace cv {
 namespace augocc {
 
@@ -26,6 +18,12 @@ namespace augocc {
 /** @brief Contour editing for one object in one frame: anchors joined by live-wire or straight
 segments, closed contours filled into a mask, undo and redo, editing of an existing mask, and
 outlines proposed from a coarse matte snapped to the image edges.
+
+Silhouette tracing (the paper's Section 5 @cite Ong1998): the user outlines a real object in a
+key frame with Intelligent Scissors @cite Mortensen1995 (OpenCV's
+cv::segmentation::IntelligentScissorsMB) plus a straight-line tool. Points are integer pixels
+(@ref augocc_conventions_pixels "pixel conventions"). All the logic lives here, so that it is
+tested headless; the `augocc annotate` window only forwards clicks and keys.
 
 A silhouette is a set of closed contours (their filled union is the mask) plus at most one open
 contour being traced. Every contour is a cyclic list of anchors; segment i joins anchor i-1 to
@@ -45,55 +43,68 @@ public:
         STRAIGHT = 1   //!< straight line, no snapping (the paper's line tool)
     };
 
+    //! Editing and snapping parameters; the defaults are the initializers.
     struct CV_EXPORTS Params
     {
-        Params();  // defaults in the comments; defined in src/ (GCC: nested NSDMI + default arg)
-        //! Intelligent Scissors feature weights: non-edge, gradient direction, gradient
-        //! magnitude (default 0.43, 0.43, 0.14, the values of Mortensen & Barrett).
-        float weightNonEdge, weightGradientDirection, weightGradientMagnitude;
-        //! Gradient magnitude at or above which a pixel costs nothing (default 150; 0 disables).
-        float gradientMagnitudeMax;
-        //! Canny thresholds of the edge feature (default 32, 100, as in OpenCV's scissors demo).
-        double cannyLow, cannyHigh;
-        //! LIVE_WIRE clicks are moved to the strongest edge pixel within this radius (pixels,
-        //! default 2; 0 keeps the click as given).
-        int clickSnapRadius;
-        //! Live wire is searched inside the bounding box of its two anchors grown by this margin
-        //! (pixels, default 24): bounded cost, and no detour through far-away texture.
-        int searchMargin;
+        //! Intelligent Scissors weight of the non-edge feature (a pixel off the Canny edges of
+        //! the frame); the three weights are those of Mortensen & Barrett.
+        float weightNonEdge = 0.43f;
+        //! Intelligent Scissors weight of the gradient-direction feature.
+        float weightGradientDirection = 0.43f;
+        //! Intelligent Scissors weight of the gradient-magnitude feature.
+        float weightGradientMagnitude = 0.14f;
+        //! Gradient magnitude at or above which a pixel costs nothing (lower snaps to weaker
+        //! edges; 0: the frame's largest magnitude instead).
+        float gradientMagnitudeMax = 150.f;
+        //! Lower Canny threshold of the edge feature (as in OpenCV's scissors demo).
+        double cannyLow = 32;
+        //! Upper Canny threshold of the edge feature (as in OpenCV's scissors demo).
+        double cannyHigh = 100;
+        //! LIVE_WIRE clicks are moved to the strongest edge pixel within this radius, pixels,
+        //! >= 0 (0 keeps the click as given).
+        int clickSnapRadius = 2;
+        //! Live wire is searched inside the bounding box of its two anchors grown by this
+        //! margin, pixels, >= 0: bounded cost, and no detour through far-away texture.
+        int searchMargin = 24;
         //! Once a contour is closed its outside is known: live-wire pixels up to outerEdgeBand
-        //! pixels inside the chord of their segment cost up to outerEdgeBias more (gradient-
+        //! pixels inside the chord of their segment cost up to this much more (gradient-
         //! magnitude feature, range [0, 1]), so the wire takes the outer of two parallel edges
-        //! (a silhouette rather than a trim just inside it). Defaults 0.5 and 4; 0 disables.
-        float outerEdgeBias;
-        int outerEdgeBand;
-        //! loadMask(): tolerance of the polygon approximation of a mask outline (pixels,
-        //! default 1.0).
-        double outlineTolerance;
-        //! snapMask(): spacing of the outline samples that are snapped (pixels, default 10).
-        int snapSpacing;
-        //! snapMask(): how far along the outline normal a sample may move (pixels, default 4).
-        int snapRadius;
-        //! snapMask(): preference for small moves: an edge at the full snapRadius scores this
-        //! fraction less than the same edge on the proposed outline (default 0.3).
-        float snapDistancePenalty;
-        //! Contours whose area is below this are ignored when a mask is loaded (pixels,
-        //! default 20).
-        double minContourArea;
+        //! (a silhouette rather than a trim just inside it). Higher prefers the outer edge
+        //! more; 0 disables.
+        float outerEdgeBias = 0.5f;
+        //! Width of that band inside the chord, pixels, >= 0 (0 disables).
+        int outerEdgeBand = 4;
+        //! loadMask(): tolerance of the polygon approximation of a mask outline, pixels, > 0
+        //! (higher: fewer anchors, a coarser outline).
+        double outlineTolerance = 1.0;
+        //! snapMask(): spacing of the outline samples that are snapped, pixels, >= 2.
+        int snapSpacing = 10;
+        //! snapMask(): how far along the outline normal a sample may move, pixels, >= 0.
+        int snapRadius = 4;
+        //! snapMask(): preference for small moves, in [0, 1]: an edge at the full snapRadius
+        //! scores this fraction less than the same edge on the proposed outline (higher keeps
+        //! the outline closer to the proposal).
+        float snapDistancePenalty = 0.3f;
+        //! Contours whose area is below this are ignored when a mask is loaded, pixels, >= 0.
+        double minContourArea = 20;
         //! getMask(): a live-wire pixel on the mask's boundary is kept only when its colour is
         //! nearer to the inside neighbour's than to the outside one's (the wire runs on edge
-        //! pixels, which belong to either side). Default true.
-        bool refineBoundary;
+        //! pixels, which belong to either side).
+        bool refineBoundary = true;
     };
 
     /** @brief Creates an editor.
-    @param params editing and snapping parameters.
+    @param params editing and snapping parameters; throws as setParams() does when they are
+    invalid.
     */
     static Ptr<SilhouetteEditor> create(const Params& params);
     //! Creates an editor with default Params.
     static Ptr<SilhouetteEditor> create();
+    //! The current parameters.
     virtual Params getParams() const = 0;
-    //! Sets parameters; throws StsBadArg on a negative radius, margin or spacing.
+    /** @brief Sets the parameters.
+    @param params the parameters; StsBadArg when one is outside the range its field states.
+    */
     virtual void setParams(const Params& params) = 0;
 
     /** @brief Sets the frame to trace on and clears the silhouette and the undo history.
@@ -103,8 +114,9 @@ public:
     //! Size of the current image (empty before setImage()).
     virtual Size getImageSize() const = 0;
 
-    //! Mode of the segments made from now on (LIVE_WIRE by default).
+    //! Mode of the segments made from now on (LIVE_WIRE by default). @param mode a SegmentMode.
     virtual void setSegmentMode(int mode) = 0;
+    //! The SegmentMode of the segments made from now on.
     virtual int getSegmentMode() const = 0;
 
     /** @brief Adds an anchor at pt (clamped to the image) to the open contour, starting one if
@@ -126,7 +138,8 @@ public:
     */
     virtual bool closeContour() = 0;
 
-    //! Removes the last anchor of the open contour (the open contour itself when it is the only one).
+    //! Removes the last anchor of the open contour (the open contour itself when it is the only
+    //! one); false when no contour is open.
     virtual bool removeLastPoint() = 0;
 
     /** @brief Finds the anchor nearest to pt within maxDistance.
@@ -153,7 +166,9 @@ public:
     virtual bool undo() = 0;
     //! Redoes the last undone edit; false when there is nothing to redo.
     virtual bool redo() = 0;
+    //! True when there is an edit to undo.
     virtual bool canUndo() const = 0;
+    //! True when there is an undone edit to redo.
     virtual bool canRedo() const = 0;
     //! Forgets the undo and redo history (e.g. after loading a saved mask).
     virtual void clearHistory() = 0;
@@ -211,7 +226,8 @@ public:
 @param params editor parameters.
 */
 CV_EXPORTS void snapMaskToEdges(InputArray image, InputArray proposed, OutputArray snapped,
-                                const SilhouetteEditor::Params& params = SilhouetteEditor::Params());
+                                const SilhouetteEditor::Params& params =
+                                    SilhouetteEditor::Params());
 
 /** @brief Visible parts of several objects' mattes by a depth test: a pixel of object i's matte
 is visible unless another object's matte covers it at a smaller depth.
