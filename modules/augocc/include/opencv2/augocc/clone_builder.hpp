@@ -10,29 +10,26 @@
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/io.hpp"
 
-/*
-Clones (the paper's Section 6 @cite Ong1998). Conventions:
-- A clone is a dense voxel grid whose axes are the columns of a rotation `Rbox` (box axes in world
-  coordinates); voxel (i, j, k) has its centre at origin + Rbox * (voxelSize * (i + 0.5, j + 0.5,
-  k + 0.5)).
-- The footprint of a voxel in an image is the set of pixel centres inside the bounding rectangle
-  of its projected cube, plus the pixel its centre rounds to. Carving keeps a voxel only when its
-  whole footprint lies in the silhouette (or in an "unknown" pixel), and render() draws exactly
-  the footprints: one rule, so that in a key frame the clone never covers a pixel outside the
-  silhouette and the patch voxels make up the rest exactly.
-- Depth is camera-space z (CONTRACT.md) of the nearest voxel centre.
-*/
-
 namespace cv {
 namespace augocc {
 
 //! @addtogroup augocc
 //! @{
 
-/** @brief The clones of the real objects (the paper's Section 6): per object a dense voxel grid
-(the trimmed model) and a set of patch voxels per key frame.
+/** @brief The clones of the real objects (the paper's Section 6 @cite Ong1998): per object a
+dense voxel grid (the trimmed model) and a set of patch voxels per key frame.
 
 This is what the compositor and `augocc matte` consume. Made by CloneBuilder::build() or load().
+
+Conventions of a clone (the module's own are in @ref augocc_conventions):
+- The grid's axes are the columns of a rotation `Rbox` (box axes in world coordinates); voxel
+  (i, j, k) has its centre at `origin + Rbox * (voxelSize * (i + 0.5, j + 0.5, k + 0.5))`.
+- The footprint of a voxel in an image is the set of pixel centres inside the bounding rectangle
+  of its projected cube, plus the pixel its centre rounds to. Carving keeps a voxel only when its
+  whole footprint lies in the silhouette (or in an "unknown" pixel), and render() draws exactly
+  the footprints: one rule, so that in a key frame the clone never covers a pixel outside the
+  silhouette and the patch voxels make up the rest exactly.
+- Depth is the camera-space z of the nearest voxel centre, as everywhere in the module.
 */
 class CV_EXPORTS CloneSet
 {
@@ -219,16 +216,18 @@ public:
         //! Steps 4 and 5: pixels under a nearer object's silhouette are unknown, not outside, so
         //! a building in front does not bite a hole in the one behind.
         bool occlusionAware = true;
-        BoxParams box;              //!< Steps 1-3
-        PatchParams patches;        //!< Step 5
-        FreeSpaceParams freeSpace;  //!< build() with tracks
-        UnobservedParams unobserved;
-        PhotoParams photo;          //!< refine()
+        BoxParams box;                //!< Steps 1-3
+        PatchParams patches;          //!< Step 5
+        FreeSpaceParams freeSpace;    //!< build() with tracks
+        UnobservedParams unobserved;  //!< build(), after the free space
+        PhotoParams photo;            //!< refine()
     };
 
+    //! Creates a builder; throws as setParams() does on invalid parameters.
     static Ptr<CloneBuilder> create(const Params& params);
     //! Creates a builder with default Params.
     static Ptr<CloneBuilder> create();
+    //! The parameters in use.
     virtual Params getParams() const = 0;
     //! Validates and sets the parameters (StsBadArg naming the field when out of range).
     virtual void setParams(const Params& params) = 0;

@@ -8,8 +8,10 @@
 #include <vector>
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/clone_builder.hpp"
+#include "opencv2/augocc/compositor.hpp"
 #include "opencv2/augocc/io.hpp"
 #include "opencv2/augocc/mesh.hpp"
+#include "opencv2/augocc/scene_synthesizer.hpp"
 
 /*
 The end-to-end runs behind `augocc composite`, `augocc run` and `augocc demo`, so that the command
@@ -32,8 +34,10 @@ struct CV_EXPORTS CompositeOptions
 {
     int firstFrame = 0;        //!< first frame composited
     int endFrame = -1;         //!< one past the last frame (-1: the end of the input)
-    int supersample = 3;       //!< Compositor::Params::supersample (1: hard edges)
-    bool antialiasVirtual = false;  //!< Compositor::Params::antialiasVirtual
+    //! Compositor::Params::supersample (1: hard edges)
+    int supersample = Compositor::Params().supersample;
+    //! Compositor::Params::antialiasVirtual
+    bool antialiasVirtual = Compositor::Params().antialiasVirtual;
     String mattesDir;          //!< if set: the clones' mattes, `DIR/<object>/%04d.png` (contract)
     /** if set: per frame `DIR/%04d.png`, 16-bit, camera-space z of the nearest surface (clone or
     virtual) as `(value - 1) / scale + offset`, 0 where nothing; `DIR/depth.yml` holds `scale`
@@ -75,11 +79,13 @@ CV_EXPORTS int compositeSequence(const String& input, const Reconstruction& rec,
 struct CV_EXPORTS RunOptions
 {
     String input;            //!< video, image folder or printf pattern
-    String masksDir;         //!< key-frame masks, MASKS/<object>/%04d.png
+    String masksDir;         //!< key-frame masks, `MASKS/<object>/%04d.png`
     String scenePath;        //!< scene.yml; empty: stop after the mattes
     String outDir;           //!< every intermediate file and the composite go here
-    int supersample = 3;     //!< compositor supersampling (1: hard edges)
-    bool antialiasVirtual = false;  //!< Compositor::Params::antialiasVirtual
+    //! Compositor::Params::supersample (1: hard edges)
+    int supersample = Compositor::Params().supersample;
+    //! Compositor::Params::antialiasVirtual
+    bool antialiasVirtual = Compositor::Params().antialiasVirtual;
     //! Carve the clones further by photo-consistency over every frame (CloneBuilder::refine).
     bool photoRefine = true;
     //! Stage progress: (stage name, done, total); a stage starts with done = 0.
@@ -89,9 +95,9 @@ struct CV_EXPORTS RunOptions
 //! What runPipeline() produced.
 struct CV_EXPORTS RunResult
 {
-    Tracks tracks;
-    Reconstruction reconstruction;
-    Ptr<CloneSet> clones;
+    Tracks tracks;                      //!< as written to tracks.yml
+    Reconstruction reconstruction;      //!< as written to reconstruction.yml
+    Ptr<CloneSet> clones;               //!< as written to clones.yml.gz
     std::vector<Mesh> virtualObjects;   //!< placed, world frame of the reconstruction
     String compositePath;               //!< empty without a scene
     std::vector<std::pair<String, double> > stageSeconds;  //!< wall time per stage
@@ -104,23 +110,28 @@ CV_EXPORTS RunResult runPipeline(const RunOptions& options);
 //! Options of runDemo() (`augocc demo`).
 struct CV_EXPORTS DemoOptions
 {
-    String outDir = "augocc_demo";
-    int frames = 60;
-    Size imageSize = Size(640, 480);
+    String outDir = "augocc_demo";  //!< everything is written here
+    //! Frames synthesized (SceneSynthesizer::Params::frames).
+    int frames = SceneSynthesizer::Params().frames;
+    //! Frame size (SceneSynthesizer::Params::imageSize).
+    Size imageSize = SceneSynthesizer::Params().imageSize;
     //! Camera model of the synthesized footage (SceneSynthesizer::Params::model).
-    CameraModel model = SCALED_ORTHOGRAPHIC;
+    CameraModel model = SceneSynthesizer::Params().model;
     //! Camera distance over the scene size (SceneSynthesizer::Params::distanceRatio; small values
     //! give strong perspective, as hand-held footage near a building).
-    double distanceRatio = 10.0;
+    double distanceRatio = SceneSynthesizer::Params().distanceRatio;
     bool photoRefine = true;  //!< RunOptions::photoRefine
+    //! Stage progress: (stage name, done, total), as RunOptions::progress.
     std::function<void(const String& stage, int done, int total)> progress;
 };
 
 //! What runDemo() produced and measured.
 struct CV_EXPORTS DemoResult
 {
-    String compositePath, contactSheetPath, scenePath;
-    RunResult run;
+    String compositePath;     //!< the composited video
+    String contactSheetPath;  //!< input frames above their composites (PNG)
+    String scenePath;         //!< the scene file the demo placed its virtual objects with
+    RunResult run;            //!< what the pipeline run on the synthesized video produced
     double fractionWithin = 0;   //!< mean over frames, composite vs ground truth (8 grey levels)
     double boundaryDistance = 0; //!< occlusion boundary, px: mean over the boundaryFrames
     int boundaryFrames = 0;      //!< frames where the truth or the composite has one
