@@ -5,6 +5,10 @@
 // virtual objects with the depth test. Beyond the paper: one depth metric (camera-space z) for
 // every camera model, and soft occlusion edges by supersampling the virtual layer against the
 // clone depth rendered at the same finer grid.
+//
+// Over 800 lines in one file: one class's render path (context, shaders, the clones' depth pass,
+// the virtual pass, the supersampled resolve) sharing its GL state; the scene file, the GL context
+// and the shading it uses are in their own files.
 
 #include "precomp.hpp"
 #include "gl_context.hpp"

@@ -5,6 +5,10 @@
 // Section 3) with missing data (largest complete block, growth by affine triangulation and
 // resection, then alternation: the ALS of Buchanan & Fitzgibbon 2005) and rejection of gross
 // outlier tracks by their residual to the affine fit.
+//
+// Over 800 lines in one file: the stages (largest complete block, growth, alternation, metric
+// upgrade, outlier rejection, refinement) work on one shared measurement-matrix representation;
+// the incremental path for long sequences with short tracks is in incremental_sfm.cpp.
 
 #include "precomp.hpp"
 #include "sfm_detail.hpp"

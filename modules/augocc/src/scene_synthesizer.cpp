@@ -4,6 +4,9 @@
 // SceneSynthesizer: a textured static scene rendered headless through OSMesa, with its ground
 // truth (cameras, 3D points, tracks, masks, depth). See scene_synthesizer.hpp for the scene and
 // doc/synthesizer.md for the outputs of `augocc synth`.
+//
+// Over 800 lines in one file: the scene's geometry and textures, the camera path, the renderer
+// and the ground truth derived from them share one private scene description (sections below).
 
 #include "precomp.hpp"
 #include "gl_context.hpp"

@@ -1,6 +1,10 @@
 // This file is part of augocc. License: Apache-2.0.
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
+// SilhouetteEditor: the annotate window's logic, headless (tracing, live wire, straight segments,
+// proposals from the clones, undo). Over 800 lines in one file because it is one class whose
+// methods share its private editing state; splitting it would put that state in a header.
+
 #include "precomp.hpp"
 #include "stats.hpp"
 

@@ -1,6 +1,10 @@
 // This file is part of augocc. License: Apache-2.0.
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
+// VoxelGrid: the module's one voxel grid. Over 800 lines in one file because carving,
+// surface extraction, footprints and splatting are one data structure's operations sharing its
+// projector and inner loops; the passes that use them live in src/clone/.
+
 #include "precomp.hpp"
 #include "voxel_grid.hpp"
 
