@@ -6,6 +6,7 @@
 #include "precomp.hpp"
 #include "clone/clone_set.hpp"
 #include "clone/clone_codec.hpp"
+#include "io_internal.hpp"
 
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -229,17 +230,7 @@ void CloneSetImpl::exportPly(const String& dir) const
 Ptr<CloneSet> CloneSet::load(const String& path)
 {
     using namespace detail;
-    FileStorage fs;
-    try
-    {
-        fs.open(path, FileStorage::READ);
-    }
-    catch (const cv::Exception& e)
-    {
-        CV_Error(Error::StsParseError, path + ": cannot parse: " + e.msg);
-    }
-    if (!fs.isOpened())
-        CV_Error(Error::StsObjectNotFound, path + ": cannot open clones file");
+    FileStorage fs = openFileStorageForRead(path, "clones file");
     if ((String)fs["format"] != "augocc_clones")
         CV_Error(Error::StsParseError, path + ": key 'format' is not 'augocc_clones'");
     Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();

@@ -140,10 +140,9 @@ std::vector<Vec3d> clusterPoints(const Reconstruction& rec, const ObjectMasks& a
     const int P = rec.points.rows;
     for (int p = 0; p < P; p++)
     {
-        const double* q = rec.points.ptr<double>(p);
-        if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+        if (!rec.hasPoint(p))
             continue;
-        const Vec3d X(q[0], q[1], q[2]);
+        const Vec3d X = rec.point(p);
         const int mine = silhouetteVotes(rec, all, object, tracks, p, X);
         if (mine <= 0)
             continue;

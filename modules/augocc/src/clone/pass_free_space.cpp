@@ -21,6 +21,7 @@
 #include "precomp.hpp"
 #include "clone/passes.hpp"
 #include "clone/key_frame_coverage.hpp"
+#include "stats.hpp"
 
 namespace cv {
 namespace augocc {
@@ -155,8 +156,7 @@ Mat freeDepthMap(const Reconstruction& rec, const Tracks& tracks, const std::vec
     std::vector<double> sorted;
     for (const Tri& t : keep)
         sorted.push_back(t.edge);
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double maxEdge = params.maxEdgeRatio * sorted[sorted.size() / 2];
+    const double maxEdge = params.maxEdgeRatio * medianInPlace(sorted);
     size_t w = 0;
     for (size_t q = 0; q < keep.size(); q++)
         if (keep[q].edge <= maxEdge || keep[q].planar)

@@ -8,6 +8,7 @@
 #include "precomp.hpp"
 #include "clone/passes.hpp"
 #include "clone/key_frame_coverage.hpp"
+#include "stats.hpp"
 
 namespace cv {
 namespace augocc {
@@ -66,8 +67,7 @@ bool consistent(const std::vector<Point>& px, const std::vector<const Mat*>& img
                 const Point q = px[v] + offs[k];
                 scratch[v] = img[v]->ptr<uchar>(q.y)[3 * q.x + c];
             }
-            std::nth_element(scratch.begin(), scratch.begin() + n / 2, scratch.end());
-            ref[k][c] = scratch[n / 2];
+            ref[k][c] = medianInPlace(scratch);
         }
     const int need = (int)std::ceil(minAgreement * n - 1e-9);
     int agree = 0;
