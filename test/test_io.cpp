@@ -3,6 +3,8 @@
 
 #include "test_precomp.hpp"
 
+#include "frame_pattern.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <opencv2/videoio.hpp>
@@ -250,6 +252,47 @@ TEST(Augocc_Masks, bad_arg)
     expectErrorMentions([&] { readMasks(dir + "/m"); }, {"frame.png", "frame index"});
 }
 
+TEST(Augocc_FramePattern, accuracy)
+{
+    using cv::augocc::detail::FramePattern;
+    using cv::augocc::detail::parseFramePattern;
+    const FramePattern a = parseFramePattern("frames/%04d.png");
+    EXPECT_EQ("frames/", a.prefix);
+    EXPECT_EQ(".png", a.suffix);
+    EXPECT_EQ("frames/0007.png", a.expand(7));
+    EXPECT_EQ("frames/12345.png", a.expand(12345));
+    EXPECT_EQ("f3.png", parseFramePattern("f%d.png").expand(3));
+    EXPECT_EQ("f  3.png", parseFramePattern("f%3d.png").expand(3));
+    EXPECT_EQ("f0000000042", parseFramePattern("f%010d").expand(42));
+    // %% is a literal '%', on either side of the conversion.
+    EXPECT_EQ("100%/x_05%.png", parseFramePattern("100%%/x_%02d%%.png").expand(5));
+    // What printf would write, for every accepted form.
+    for (const char* fmt : {"%d", "%0d", "%1d", "%5d", "%05d", "%10d", "%010d", "a%%%03d%%b"})
+        for (int i : {0, 1, 9, 10, 999, 123456, std::numeric_limits<int>::max()})
+            EXPECT_EQ(cv::format(fmt, i), parseFramePattern(fmt).expand(i)) << fmt << " " << i;
+}
+
+TEST(Augocc_FramePattern, bad_arg)
+{
+    // Each is StsBadArg naming the pattern, never handed to printf.
+    for (const char* bad : {"%s.png", "%n", "%d%d", "%5s", "x/%04d_%d.png", "%", "frame%",
+                            "%%", "none", "%ld", "%i", "%x", "%u", "%-4d", "%+d", "% d", "%.3d",
+                            "%*d", "%00d", "%011d", "%123d", "%04s", "%1$d", "%p", "%04d%n"})
+    {
+        try
+        {
+            cv::augocc::detail::parseFramePattern(bad);
+            ADD_FAILURE() << "accepted: " << bad;
+        }
+        catch (const cv::Exception& e)
+        {
+            EXPECT_EQ(Error::StsBadArg, e.code) << bad;
+            EXPECT_NE(e.err.find(String("'") + bad + "'"), String::npos) << e.err;
+            EXPECT_NE(e.err.find("frame pattern"), String::npos) << e.err;
+        }
+    }
+}
+
 TEST(Augocc_FrameSource, accuracy)
 {
     const std::string dir = tempDir("io");
@@ -274,6 +317,18 @@ TEST(Augocc_FrameSource, accuracy)
         ASSERT_TRUE(src->read(f));
         EXPECT_EQ(f.at<Vec3b>(0, 0)[0], 30);
     }
+    // '%' in a folder name is written %%; a file that exists is read as itself, '%' or not.
+    fs::create_directories(dir + "/100%");
+    for (int i = 1; i <= 3; i++)
+        cv::imwrite(cv::format("%s/100%%/f%d.png", dir.c_str(), i),
+                    Mat(24, 32, CV_8UC3, Scalar(i, 0, 0)));
+    Ptr<FrameSource> pct = FrameSource::open(dir + "/100%%/f%d.png");
+    EXPECT_EQ(3, pct->count());
+    Mat first;
+    ASSERT_TRUE(pct->read(first));
+    EXPECT_EQ(1, first.at<Vec3b>(0, 0)[0]);
+    cv::imwrite(dir + "/lit%s.png", Mat(24, 32, CV_8UC3, Scalar::all(7)));
+    EXPECT_EQ(1, FrameSource::open(dir + "/lit%s.png")->count());
     // A video written with OpenCV reads back frame for frame.
     const std::string video = dir + "/v.avi";
     {
@@ -304,6 +359,10 @@ TEST(Augocc_FrameSource, bad_arg)
     fs::create_directories(dir + "/empty");
     expectErrorMentions([&] { FrameSource::open(dir + "/empty"); }, {"empty", "no image"});
     expectErrorMentions([&] { FrameSource::open(dir + "/x/%04d.png"); }, {"pattern"});
+    // A pattern is never a format: each of these crashed or read garbage through printf.
+    for (const char* bad : {"%s.png", "%n", "%d%d", "%5s", "%n%s%s%s%s%s%s%s%s.png"})
+        expectErrorMentions([&] { FrameSource::open(dir + "/" + bad); },
+                            {dir + "/" + bad, "not a frame pattern"});
     fs::create_directories(dir + "/mixed");
     cv::imwrite(dir + "/mixed/0000.png", Mat(24, 32, CV_8UC3, Scalar::all(0)));
     cv::imwrite(dir + "/mixed/0001.png", Mat(20, 32, CV_8UC3, Scalar::all(0)));

@@ -3,6 +3,8 @@
 
 #include "precomp.hpp"
 
+#include "frame_pattern.hpp"
+
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -619,6 +621,71 @@ bool isImageFile(const fs::path& p)
 
 } // namespace
 
+namespace detail {
+
+String FramePattern::expand(int index) const
+{
+    CV_Assert(index >= 0);
+    String digits = std::to_string(index);
+    if ((int)digits.size() < width)
+        digits.insert(0, width - digits.size(), zeroPad ? '0' : ' ');
+    return prefix + digits + suffix;
+}
+
+FramePattern parseFramePattern(const String& pattern)
+{
+    const String what = "'" + pattern + "': not a frame pattern: ";
+    const String expected = " (expected one %d, %Nd or %0Nd, as in frames/%04d.png; %% for a "
+                            "literal %)";
+    FramePattern p;
+    bool converted = false;
+    for (size_t i = 0; i < pattern.size(); i++)
+    {
+        String& literal = converted ? p.suffix : p.prefix;
+        if (pattern[i] != '%')
+        {
+            literal += pattern[i];
+            continue;
+        }
+        if (i + 1 < pattern.size() && pattern[i + 1] == '%')
+        {
+            literal += '%';
+            i++;
+            continue;
+        }
+        // %[0][N]d; the conversion spans [i, j].
+        size_t j = i + 1;
+        const bool zero = j < pattern.size() && pattern[j] == '0';
+        if (zero)
+            j++;
+        const size_t digitsStart = j;
+        while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9')
+            j++;
+        const String digits = pattern.substr(digitsStart, j - digitsStart);
+        if (j >= pattern.size() || pattern[j] != 'd' || (zero && !digits.empty() &&
+                                                          digits[0] == '0'))
+        {
+            const size_t shown = std::min(pattern.size(), j + 1) - i;
+            CV_Error(Error::StsBadArg, what + "'" + pattern.substr(i, shown) + "' is not an "
+                     "integer conversion" + expected);
+        }
+        if (converted)
+            CV_Error(Error::StsBadArg, what + "more than one conversion" + expected);
+        if (digits.size() > 2 || (!digits.empty() && std::stoi(digits) > kMaxFramePatternWidth))
+            CV_Error(Error::StsBadArg, what + "width " + digits + cv::format(" is over %d",
+                     kMaxFramePatternWidth) + expected);
+        p.width = digits.empty() ? 0 : std::stoi(digits);
+        p.zeroPad = zero;
+        converted = true;
+        i = j;
+    }
+    if (!converted)
+        CV_Error(Error::StsBadArg, what + "no integer conversion" + expected);
+    return p;
+}
+
+} // namespace detail
+
 Ptr<FrameSource> FrameSource::open(const String& input)
 {
     if (input.empty())
@@ -635,21 +702,20 @@ Ptr<FrameSource> FrameSource::open(const String& input)
             CV_Error(Error::StsObjectNotFound, input + ": folder holds no image");
         return makePtr<ImageListSource>(input, files);
     }
-    if (input.find('%') != String::npos)
+    if (input.find('%') != String::npos && !fs::exists(input))
     {
+        // Expanded here, never by printf or by VideoCapture (whose image sequences would use
+        // the user's text as a format): a bad pattern is an error before any file is looked at.
+        const detail::FramePattern pattern = detail::parseFramePattern(input);
         std::vector<String> files;
-        for (int i = 0;; i++)
+        for (int i = 0; i < std::numeric_limits<int>::max(); i++)
         {
-            const String f = cv::format(input.c_str(), i);
+            const String f = pattern.expand(i);
             if (!fs::exists(f))
             {
-                if (i == 0)
-                {
-                    // Patterns may start at 1 (ffmpeg's default).
-                    const String f1 = cv::format(input.c_str(), 1);
-                    if (fs::exists(f1))
-                        continue;
-                }
+                // Patterns may start at 1 (ffmpeg's default).
+                if (i == 0 && fs::exists(pattern.expand(1)))
+                    continue;
                 break;
             }
             files.push_back(f);

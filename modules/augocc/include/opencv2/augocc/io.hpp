@@ -104,7 +104,13 @@ class CV_EXPORTS FrameSource
 public:
     virtual ~FrameSource();
     /** @brief Opens the input; throws StsObjectNotFound / StsBadArg naming it when it cannot be
-    opened or holds no frame. */
+    opened or holds no frame.
+
+    An input that names no existing file and holds a '%' is a frame pattern: literal text, `%%`
+    for a literal '%', and exactly one integer conversion `%d`, `%Nd` or `%0Nd` (N <= 10); frame
+    i is the i-th existing file from index 0 (or 1 when index 0 is absent). Any other pattern is
+    StsBadArg naming it. The pattern is expanded by augocc and the files read with imread: it is
+    never used as a printf or VideoCapture format. */
     static Ptr<FrameSource> open(const String& input);
     //! Number of frames (exact for folders and patterns; the container's count for videos).
     virtual int count() const = 0;
