@@ -5,6 +5,8 @@
 
 #include "frame_pattern.hpp"
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <opencv2/videoio.hpp>
@@ -250,6 +252,35 @@ TEST(Augocc_Masks, bad_arg)
     fs::remove(dir + "/m/obj/0002.png");
     cv::imwrite(dir + "/m/obj/frame.png", Mat::zeros(10, 12, CV_8U));
     expectErrorMentions([&] { readMasks(dir + "/m"); }, {"frame.png", "frame index"});
+}
+
+TEST(Augocc_WriteAtomically, bad_arg)
+{
+    const std::string dir = tempDir("io");
+    const std::string path = dir + "/out.yml";
+    std::string tmp;
+    // A std::filesystem error of the writer becomes StsError naming the output and the reason.
+    try
+    {
+        writeAtomically(path, [&](const String& t) {
+            tmp = t;
+            writeText(dir, fs::path(t).filename().string(), "partial");
+            throw fs::filesystem_error("create_directories", t,
+                                       std::make_error_code(std::errc::read_only_file_system));
+        });
+        ADD_FAILURE() << "no exception";
+    }
+    catch (const cv::Exception& e)
+    {
+        EXPECT_EQ(Error::StsError, e.code);
+        EXPECT_NE(std::string::npos, e.err.find(path)) << e.err;
+        EXPECT_NE(std::string::npos, e.err.find("Read-only file system")) << e.err;
+    }
+    EXPECT_FALSE(tmp.empty());
+    EXPECT_FALSE(fs::exists(tmp));
+    expectErrorMentions([&] { writeAtomically(path, [](const String&) {}); },
+                        {path, "nothing was written"});
+    EXPECT_TRUE(fs::is_empty(dir));
 }
 
 TEST(Augocc_FramePattern, accuracy)

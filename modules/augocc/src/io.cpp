@@ -3,6 +3,7 @@
 
 #include "precomp.hpp"
 
+#include "atomic_write.hpp"
 #include "frame_pattern.hpp"
 
 #include <cstdio>
@@ -112,51 +113,7 @@ M readFixedMat(const FileNode& parent, const char* key, const String& where)
     return M(md.ptr<double>());
 }
 
-String tmpNameFor(const String& path)
-{
-    fs::path p(path);
-    // Keep the extension so that FileStorage / imwrite pick the same format.
-    String stem = p.filename().string();
-    String ext;
-    const String gz = ".gz";
-    if (stem.size() > gz.size() && stem.compare(stem.size() - gz.size(), gz.size(), gz) == 0)
-    {
-        fs::path inner(stem.substr(0, stem.size() - gz.size()));
-        ext = inner.extension().string() + gz;
-        stem = inner.stem().string();
-    }
-    else
-    {
-        ext = p.extension().string();
-        stem = p.stem().string();
-    }
-    fs::path dir = p.parent_path();
-    String name = "." + stem + cv::format(".tmp%d", (int)cv::getTickCount() & 0xffff) + ext;
-    return (dir / name).string();
-}
-
 } // namespace
-
-void writeAtomically(const String& path, const std::function<void(const String& tmpPath)>& writer)
-{
-    const String tmp = tmpNameFor(path);
-    try
-    {
-        writer(tmp);
-        std::error_code ec;
-        if (fs::is_directory(path) && fs::is_directory(tmp))
-            fs::remove_all(path, ec);
-        fs::rename(tmp, path, ec);
-        if (ec)
-            CV_Error(Error::StsError, path + ": cannot rename from " + tmp + ": " + ec.message());
-    }
-    catch (...)
-    {
-        std::error_code ec;
-        fs::remove_all(tmp, ec);
-        throw;
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Tracks
@@ -224,16 +181,12 @@ Tracks readTracks(const String& path)
 void writeTracks(const String& path, const Tracks& tracks)
 {
     tracks.validate(path);
-    writeAtomically(path, [&](const String& tmp) {
-        FileStorage storage(tmp, FileStorage::WRITE);
-        if (!storage.isOpened())
-            CV_Error(Error::StsError, path + ": cannot open for writing");
+    detail::writeStorageAtomically(path, [&](FileStorage& storage) {
         storage << "image_size" << (Mat_<int>(1, 2) << tracks.imageSize.width,
                                     tracks.imageSize.height);
         storage << "frames" << tracks.frames();
         storage << "points" << tracks.points();
         storage << "tracks" << tracks.tracks;
-        storage.release();
     });
 }
 
@@ -379,10 +332,7 @@ Reconstruction readReconstruction(const String& path)
 void writeReconstruction(const String& path, const Reconstruction& rec)
 {
     rec.validate(path);
-    writeAtomically(path, [&](const String& tmp) {
-        FileStorage storage(tmp, FileStorage::WRITE);
-        if (!storage.isOpened())
-            CV_Error(Error::StsError, path + ": cannot open for writing");
+    detail::writeStorageAtomically(path, [&](FileStorage& storage) {
         storage << "model" << cameraModelName(rec.model);
         storage << "image_size" << (Mat_<int>(1, 2) << rec.imageSize.width,
                                     rec.imageSize.height);
@@ -403,7 +353,6 @@ void writeReconstruction(const String& path, const Reconstruction& rec)
         }
         storage << "]";
         storage << "points" << (rec.points.empty() ? Mat(0, 3, CV_64F) : rec.points);
-        storage.release();
     });
 }
 
@@ -467,21 +416,21 @@ void writeMasks(const String& dir, const ObjectMasks& masks)
 {
     fs::path target(dir);
     if (target.has_parent_path())
-        fs::create_directories(target.parent_path());
+        detail::createDirectories(target.parent_path().string());
     writeAtomically(dir, [&](const String& tmp) {
-        fs::create_directories(tmp);
+        detail::createDirectories(tmp, dir);
         for (const auto& obj : masks)
         {
             if (obj.first.empty() || obj.first.find('/') != String::npos)
                 CV_Error(Error::StsBadArg, "invalid object name '" + obj.first + "'");
             fs::path od = fs::path(tmp) / obj.first;
-            fs::create_directories(od);
+            detail::createDirectories(od.string(), (target / obj.first).string());
             for (const auto& fm : obj.second)
             {
                 CV_CheckTypeEQ(fm.second.type(), CV_8UC1, "masks must be 8-bit single channel");
-                const String file = (od / cv::format("%04d.png", fm.first)).string();
-                if (!cv::imwrite(file, fm.second))
-                    CV_Error(Error::StsError, dir + ": cannot write " + file);
+                const String name = cv::format("%04d.png", fm.first);
+                detail::writeImageFile((od / name).string(), fm.second,
+                                       (target / obj.first / name).string());
             }
         }
     });
