@@ -403,5 +403,44 @@ TEST(Augocc_CliIo, bad_input_pattern_is_not_a_format)
         << output;
 }
 
+TEST(Augocc_CliIo, regression_stale_temporaries_swept)
+{
+    // Temporaries a killed run left (both namings: tick count, and PID-counter of a process
+    // that is gone) go with the next write of the same output; others stay.
+    const IoData& d = ioData();
+    ASSERT_TRUE(d.ok);
+    const String out = tempDir("out");
+    int dead = 4000000;
+    while (kill(dead, 0) == 0 || errno == EPERM)
+        dead--;
+    auto touch = [&](const String& name) { std::ofstream(out + "/" + name) << "partial"; };
+    const std::vector<String> stale = {".reconstruction.tmp123.yml",
+                                       cv::format(".reconstruction.tmp%d-3.yml", dead),
+                                       ".clones.tmp9.yml.gz", ".composite.tmp77.mp4"};
+    for (const String& s : stale)
+        touch(s);
+    fs::create_directories(out + "/.mattes.tmp4137/tower");
+    touch(".mattes.tmp4137/tower/0000.png");
+    const std::vector<String> kept = {
+        cv::format(".reconstruction.tmp%d-1.yml", (int)getpid()),  // a live writer's
+        ".reconstruction.tmpx.yml", "reconstruction.tmp1.yml", ".reconstruction.tmp1.yml.bak",
+        ".other.tmp1.yml"};
+    for (const String& k : kept)
+        touch(k);
+    String output;
+    for (const auto& args : {sfmArgs(d, out), cloneArgs(d, out), matteArgs(d, out),
+                             compositeArgs(d, out)})
+        ASSERT_EQ(0, runCommand(augoccBinary() + " --quiet " + args, &output)) << output;
+    std::vector<String> expected = kept;
+    for (const char* o : {"reconstruction.yml", "clones.yml.gz", "composite.mp4", "mattes"})
+        expected.push_back(o);
+    std::vector<String> left;
+    for (const auto& e : fs::directory_iterator(out))
+        left.push_back(e.path().filename().string());
+    std::sort(left.begin(), left.end());
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(expected, left);
+}
+
 } // namespace
 } // namespace opencv_test

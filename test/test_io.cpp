@@ -254,6 +254,33 @@ TEST(Augocc_Masks, bad_arg)
     expectErrorMentions([&] { readMasks(dir + "/m"); }, {"frame.png", "frame index"});
 }
 
+TEST(Augocc_WriteAtomically, regression_stale_temporaries)
+{
+    // What a killed run leaves beside its output goes with the next write of the same output;
+    // a live writer's temporary and other names stay.
+    const std::string dir = tempDir("io");
+    const std::vector<std::string> stale = {".tracks.tmp4242.yml", ".tracks.tmp999999999-7.yml"};
+    const std::vector<std::string> kept = {cv::format(".tracks.tmp%d-9.yml", (int)getpid()),
+                                           ".tracks.tmp12.yml.gz", ".tracks.tmp.yml",
+                                           ".tracks.tmp1-x.yml", "tracks.tmp1.yml"};
+    for (const std::string& n : stale)
+        writeText(dir, n, "half a file");
+    for (const std::string& n : kept)
+        writeText(dir, n, "another file");
+    writeTracks(dir + "/tracks.yml", makeTracks(4, 5));
+    for (const std::string& n : stale)
+        EXPECT_FALSE(fs::exists(dir + "/" + n)) << n;
+    for (const std::string& n : kept)
+        EXPECT_TRUE(fs::exists(dir + "/" + n)) << n;
+    // Folder outputs too.
+    fs::create_directories(dir + "/.masks.tmp17/obj");
+    writeText(dir + "/.masks.tmp17/obj", "0000.png", "half");
+    ObjectMasks m;
+    m["obj"][0] = Mat::zeros(4, 4, CV_8U);
+    writeMasks(dir + "/masks", m);
+    EXPECT_FALSE(fs::exists(dir + "/.masks.tmp17"));
+}
+
 TEST(Augocc_WriteAtomically, bad_arg)
 {
     const std::string dir = tempDir("io");

@@ -10,6 +10,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
@@ -90,6 +91,13 @@ void syncTree(const fs::path& p, const String& shown)
     }
     else if (fs::is_regular_file(fs::symlink_status(p, ec)))
         syncPath(p, false, shown);
+}
+
+bool processAlive(long pid)
+{
+    if (pid <= 0 || pid != (long)(pid_t)pid)
+        return false;
+    return ::kill((pid_t)pid, 0) == 0 || errno == EPERM;
 }
 
 // The folder that holds `path` ("." for a bare name).
@@ -192,6 +200,42 @@ String tmpNameFor(const String& path)
     splitName(fs::path(path).filename().string(), stem, ext);
     const String name = "." + stem + cv::format(".tmp%ld-%d", (long)::getpid(), ++counter) + ext;
     return (fs::path(path).parent_path() / name).string();
+}
+
+void sweepStaleTemporaries(const String& path)
+{
+    String stem, ext;
+    splitName(fs::path(path).filename().string(), stem, ext);
+    const String head = "." + stem + ".tmp";
+    std::error_code ec;
+    fs::directory_iterator it(parentOf(path), ec), end;
+    std::vector<fs::path> stale;
+    for (; !ec && it != end; it.increment(ec))
+    {
+        const String name = it->path().filename().string();
+        if (name.size() <= head.size() + ext.size() || name.compare(0, head.size(), head) != 0 ||
+            !endsWith(name, ext))
+            continue;
+        // N or N-K between head and ext: N the writer's PID (K its counter) or, before the
+        // PID was in the name, a tick count.
+        const String mid = name.substr(head.size(), name.size() - head.size() - ext.size());
+        const size_t dash = mid.find('-');
+        const String n = mid.substr(0, dash), k = dash == String::npos ? "" : mid.substr(dash + 1);
+        auto digits = [](const String& s) {
+            return !s.empty() && s.size() < 12 &&
+                   std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+        };
+        if (!digits(n) || (dash != String::npos && !digits(k)))
+            continue;
+        if (dash != String::npos && processAlive(std::stol(n)))
+            continue;  // another writer, still at work
+        stale.push_back(it->path());
+    }
+    for (const fs::path& p : stale)
+    {
+        CV_LOG_INFO(NULL, "augocc: removing " << p.string() << ", left by an interrupted run");
+        fs::remove_all(p, ec);
+    }
 }
 
 void commitTemporary(const String& tmp, const String& path)
@@ -327,6 +371,7 @@ void checkVideoFile(const String& file, int frames, const String& shown)
 
 void writeAtomically(const String& path, const std::function<void(const String& tmpPath)>& writer)
 {
+    detail::sweepStaleTemporaries(path);
     const String tmp = detail::tmpNameFor(path);
     auto removeTmp = [&tmp]() {
         std::error_code ec;

@@ -26,6 +26,10 @@ namespace detail {
 from (`.yml.gz` kept whole). */
 String tmpNameFor(const String& path);
 
+/** @brief Removes temporaries of `path` (`.STEM.tmpN.EXT`, `.STEM.tmpN-K.EXT`) that a killed
+earlier run left beside it; those of a process still running (N its PID) stay. */
+void sweepStaleTemporaries(const String& path);
+
 /** @brief Makes `tmp` durable and renames it onto `path` (an existing folder `path` is replaced
 by a folder `tmp`): fsync of every file and folder under `tmp`, rename, fsync of the folder. */
 void commitTemporary(const String& tmp, const String& path);

@@ -43,6 +43,7 @@ public:
             madeDir_ = top.string();
             detail::createDirectories(p.parent_path().string());
         }
+        detail::sweepStaleTemporaries(path);
         tmp_ = detail::tmpNameFor(path);
     }
     ~PendingOutput()

@@ -129,9 +129,10 @@ public:
 /** @brief Writes `path` all or nothing: `writer(tmpPath)` writes a temporary sibling
 (`.STEM.tmpPID-K.EXT`, same extension), which is fsync'ed (every file and folder under it) and
 renamed onto `path`, then the folder is fsync'ed. On failure the temporary is removed and the
-error rethrown (a std::filesystem error as StsError naming `path` and the OS reason). `writer`
-must check its own writes: FileStorage and imwrite do not report a full disk (the module's
-writers write through checked calls). Used by every writer of the module (and the CLI). */
+error rethrown (a std::filesystem error as StsError naming `path` and the OS reason). Temporaries
+of `path` that a killed earlier run left are removed first. `writer` must check its own writes:
+FileStorage and imwrite do not report a full disk (the module's writers write through checked
+calls). Used by every writer of the module (and the CLI). */
 CV_EXPORTS void writeAtomically(const String& path,
                                 const std::function<void(const String& tmpPath)>& writer);
 
