@@ -3,6 +3,10 @@
 
 #include "test_precomp.hpp"
 
+#include "frame_pattern.hpp"
+
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <opencv2/videoio.hpp>
@@ -250,6 +254,103 @@ TEST(Augocc_Masks, bad_arg)
     expectErrorMentions([&] { readMasks(dir + "/m"); }, {"frame.png", "frame index"});
 }
 
+TEST(Augocc_WriteAtomically, regression_stale_temporaries)
+{
+    // What a killed run leaves beside its output goes with the next write of the same output;
+    // a live writer's temporary and other names stay.
+    const std::string dir = tempDir("io");
+    const std::vector<std::string> stale = {".tracks.tmp4242.yml", ".tracks.tmp999999999-7.yml"};
+    const std::vector<std::string> kept = {cv::format(".tracks.tmp%d-9.yml", (int)getpid()),
+                                           ".tracks.tmp12.yml.gz", ".tracks.tmp.yml",
+                                           ".tracks.tmp1-x.yml", "tracks.tmp1.yml"};
+    for (const std::string& n : stale)
+        writeText(dir, n, "half a file");
+    for (const std::string& n : kept)
+        writeText(dir, n, "another file");
+    writeTracks(dir + "/tracks.yml", makeTracks(4, 5));
+    for (const std::string& n : stale)
+        EXPECT_FALSE(fs::exists(dir + "/" + n)) << n;
+    for (const std::string& n : kept)
+        EXPECT_TRUE(fs::exists(dir + "/" + n)) << n;
+    // Folder outputs too.
+    fs::create_directories(dir + "/.masks.tmp17/obj");
+    writeText(dir + "/.masks.tmp17/obj", "0000.png", "half");
+    ObjectMasks m;
+    m["obj"][0] = Mat::zeros(4, 4, CV_8U);
+    writeMasks(dir + "/masks", m);
+    EXPECT_FALSE(fs::exists(dir + "/.masks.tmp17"));
+}
+
+TEST(Augocc_WriteAtomically, bad_arg)
+{
+    const std::string dir = tempDir("io");
+    const std::string path = dir + "/out.yml";
+    std::string tmp;
+    // A std::filesystem error of the writer becomes StsError naming the output and the reason.
+    try
+    {
+        writeAtomically(path, [&](const String& t) {
+            tmp = t;
+            writeText(dir, fs::path(t).filename().string(), "partial");
+            throw fs::filesystem_error("create_directories", t,
+                                       std::make_error_code(std::errc::read_only_file_system));
+        });
+        ADD_FAILURE() << "no exception";
+    }
+    catch (const cv::Exception& e)
+    {
+        EXPECT_EQ(Error::StsError, e.code);
+        EXPECT_NE(std::string::npos, e.err.find(path)) << e.err;
+        EXPECT_NE(std::string::npos, e.err.find("Read-only file system")) << e.err;
+    }
+    EXPECT_FALSE(tmp.empty());
+    EXPECT_FALSE(fs::exists(tmp));
+    expectErrorMentions([&] { writeAtomically(path, [](const String&) {}); },
+                        {path, "nothing was written"});
+    EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(Augocc_FramePattern, accuracy)
+{
+    using cv::augocc::detail::FramePattern;
+    using cv::augocc::detail::parseFramePattern;
+    const FramePattern a = parseFramePattern("frames/%04d.png");
+    EXPECT_EQ("frames/", a.prefix);
+    EXPECT_EQ(".png", a.suffix);
+    EXPECT_EQ("frames/0007.png", a.expand(7));
+    EXPECT_EQ("frames/12345.png", a.expand(12345));
+    EXPECT_EQ("f3.png", parseFramePattern("f%d.png").expand(3));
+    EXPECT_EQ("f  3.png", parseFramePattern("f%3d.png").expand(3));
+    EXPECT_EQ("f0000000042", parseFramePattern("f%010d").expand(42));
+    // %% is a literal '%', on either side of the conversion.
+    EXPECT_EQ("100%/x_05%.png", parseFramePattern("100%%/x_%02d%%.png").expand(5));
+    // What printf would write, for every accepted form.
+    for (const char* fmt : {"%d", "%0d", "%1d", "%5d", "%05d", "%10d", "%010d", "a%%%03d%%b"})
+        for (int i : {0, 1, 9, 10, 999, 123456, std::numeric_limits<int>::max()})
+            EXPECT_EQ(cv::format(fmt, i), parseFramePattern(fmt).expand(i)) << fmt << " " << i;
+}
+
+TEST(Augocc_FramePattern, bad_arg)
+{
+    // Each is StsBadArg naming the pattern, never handed to printf.
+    for (const char* bad : {"%s.png", "%n", "%d%d", "%5s", "x/%04d_%d.png", "%", "frame%",
+                            "%%", "none", "%ld", "%i", "%x", "%u", "%-4d", "%+d", "% d", "%.3d",
+                            "%*d", "%00d", "%011d", "%123d", "%04s", "%1$d", "%p", "%04d%n"})
+    {
+        try
+        {
+            cv::augocc::detail::parseFramePattern(bad);
+            ADD_FAILURE() << "accepted: " << bad;
+        }
+        catch (const cv::Exception& e)
+        {
+            EXPECT_EQ(Error::StsBadArg, e.code) << bad;
+            EXPECT_NE(e.err.find(String("'") + bad + "'"), String::npos) << e.err;
+            EXPECT_NE(e.err.find("frame pattern"), String::npos) << e.err;
+        }
+    }
+}
+
 TEST(Augocc_FrameSource, accuracy)
 {
     const std::string dir = tempDir("io");
@@ -274,6 +375,18 @@ TEST(Augocc_FrameSource, accuracy)
         ASSERT_TRUE(src->read(f));
         EXPECT_EQ(f.at<Vec3b>(0, 0)[0], 30);
     }
+    // '%' in a folder name is written %%; a file that exists is read as itself, '%' or not.
+    fs::create_directories(dir + "/100%");
+    for (int i = 1; i <= 3; i++)
+        cv::imwrite(cv::format("%s/100%%/f%d.png", dir.c_str(), i),
+                    Mat(24, 32, CV_8UC3, Scalar(i, 0, 0)));
+    Ptr<FrameSource> pct = FrameSource::open(dir + "/100%%/f%d.png");
+    EXPECT_EQ(3, pct->count());
+    Mat first;
+    ASSERT_TRUE(pct->read(first));
+    EXPECT_EQ(1, first.at<Vec3b>(0, 0)[0]);
+    cv::imwrite(dir + "/lit%s.png", Mat(24, 32, CV_8UC3, Scalar::all(7)));
+    EXPECT_EQ(1, FrameSource::open(dir + "/lit%s.png")->count());
     // A video written with OpenCV reads back frame for frame.
     const std::string video = dir + "/v.avi";
     {
@@ -304,6 +417,10 @@ TEST(Augocc_FrameSource, bad_arg)
     fs::create_directories(dir + "/empty");
     expectErrorMentions([&] { FrameSource::open(dir + "/empty"); }, {"empty", "no image"});
     expectErrorMentions([&] { FrameSource::open(dir + "/x/%04d.png"); }, {"pattern"});
+    // A pattern is never a format: each of these crashed or read garbage through printf.
+    for (const char* bad : {"%s.png", "%n", "%d%d", "%5s", "%n%s%s%s%s%s%s%s%s.png"})
+        expectErrorMentions([&] { FrameSource::open(dir + "/" + bad); },
+                            {dir + "/" + bad, "not a frame pattern"});
     fs::create_directories(dir + "/mixed");
     cv::imwrite(dir + "/mixed/0000.png", Mat(24, 32, CV_8UC3, Scalar::all(0)));
     cv::imwrite(dir + "/mixed/0001.png", Mat(20, 32, CV_8UC3, Scalar::all(0)));

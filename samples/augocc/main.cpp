@@ -1,6 +1,7 @@
 // augocc: put virtual 3D objects into a video of a static scene so that real objects hide them.
 // Usage: augocc <sub-command> --help
 
+#include <filesystem>
 #include <iostream>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
@@ -50,6 +51,14 @@ int main(int argc, char** argv)
                               e.code == cv::Error::StsAssert;
         std::cerr << "augocc: " << (e.err.empty() ? e.msg : e.err) << std::endl;
         return internal ? 1 : 2;
+    }
+    catch (const std::filesystem::filesystem_error& e)
+    {
+        // A folder that cannot be made or listed (read-only, permissions, full): the user's
+        // paths, not augocc's own failure. The library reports these itself; this is the net.
+        std::cerr << "augocc: " << (e.path1().empty() ? std::string() : e.path1().string() + ": ")
+                  << e.code().message() << std::endl;
+        return 2;
     }
     catch (const std::exception& e)
     {

@@ -4,6 +4,9 @@
 #include "precomp.hpp"
 #include "io_internal.hpp"
 
+#include "atomic_write.hpp"
+#include "frame_pattern.hpp"
+
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -92,29 +95,6 @@ M readFixedMat(const FileNode& parent, const char* key, const String& where)
     return M(md.ptr<double>());
 }
 
-String tmpNameFor(const String& path)
-{
-    fs::path p(path);
-    // Keep the extension so that FileStorage / imwrite pick the same format.
-    String stem = p.filename().string();
-    String ext;
-    const String gz = ".gz";
-    if (stem.size() > gz.size() && stem.compare(stem.size() - gz.size(), gz.size(), gz) == 0)
-    {
-        fs::path inner(stem.substr(0, stem.size() - gz.size()));
-        ext = inner.extension().string() + gz;
-        stem = inner.stem().string();
-    }
-    else
-    {
-        ext = p.extension().string();
-        stem = p.stem().string();
-    }
-    fs::path dir = p.parent_path();
-    String name = "." + stem + cv::format(".tmp%d", (int)cv::getTickCount() & 0xffff) + ext;
-    return (dir / name).string();
-}
-
 } // namespace
 
 namespace detail {
@@ -139,27 +119,6 @@ FileStorage openFileStorageForRead(const String& path, const String& what)
 }
 
 } // namespace detail
-
-void writeAtomically(const String& path, const std::function<void(const String& tmpPath)>& writer)
-{
-    const String tmp = tmpNameFor(path);
-    try
-    {
-        writer(tmp);
-        std::error_code ec;
-        if (fs::is_directory(path) && fs::is_directory(tmp))
-            fs::remove_all(path, ec);
-        fs::rename(tmp, path, ec);
-        if (ec)
-            CV_Error(Error::StsError, path + ": cannot rename from " + tmp + ": " + ec.message());
-    }
-    catch (...)
-    {
-        std::error_code ec;
-        fs::remove_all(tmp, ec);
-        throw;
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Tracks
@@ -227,16 +186,12 @@ Tracks readTracks(const String& path)
 void writeTracks(const String& path, const Tracks& tracks)
 {
     tracks.validate(path);
-    writeAtomically(path, [&](const String& tmp) {
-        FileStorage storage(tmp, FileStorage::WRITE);
-        if (!storage.isOpened())
-            CV_Error(Error::StsError, path + ": cannot open for writing");
+    detail::writeStorageAtomically(path, [&](FileStorage& storage) {
         storage << "image_size" << (Mat_<int>(1, 2) << tracks.imageSize.width,
                                     tracks.imageSize.height);
         storage << "frames" << tracks.frames();
         storage << "points" << tracks.points();
         storage << "tracks" << tracks.tracks;
-        storage.release();
     });
 }
 
@@ -382,10 +337,7 @@ Reconstruction readReconstruction(const String& path)
 void writeReconstruction(const String& path, const Reconstruction& rec)
 {
     rec.validate(path);
-    writeAtomically(path, [&](const String& tmp) {
-        FileStorage storage(tmp, FileStorage::WRITE);
-        if (!storage.isOpened())
-            CV_Error(Error::StsError, path + ": cannot open for writing");
+    detail::writeStorageAtomically(path, [&](FileStorage& storage) {
         storage << "model" << cameraModelName(rec.model);
         storage << "image_size" << (Mat_<int>(1, 2) << rec.imageSize.width,
                                     rec.imageSize.height);
@@ -406,7 +358,6 @@ void writeReconstruction(const String& path, const Reconstruction& rec)
         }
         storage << "]";
         storage << "points" << (rec.points.empty() ? Mat(0, 3, CV_64F) : rec.points);
-        storage.release();
     });
 }
 
@@ -470,21 +421,21 @@ void writeMasks(const String& dir, const ObjectMasks& masks)
 {
     fs::path target(dir);
     if (target.has_parent_path())
-        fs::create_directories(target.parent_path());
+        detail::createDirectories(target.parent_path().string());
     writeAtomically(dir, [&](const String& tmp) {
-        fs::create_directories(tmp);
+        detail::createDirectories(tmp, dir);
         for (const auto& obj : masks)
         {
             if (obj.first.empty() || obj.first.find('/') != String::npos)
                 CV_Error(Error::StsBadArg, "invalid object name '" + obj.first + "'");
             fs::path od = fs::path(tmp) / obj.first;
-            fs::create_directories(od);
+            detail::createDirectories(od.string(), (target / obj.first).string());
             for (const auto& fm : obj.second)
             {
                 CV_CheckTypeEQ(fm.second.type(), CV_8UC1, "masks must be 8-bit single channel");
-                const String file = (od / cv::format("%04d.png", fm.first)).string();
-                if (!cv::imwrite(file, fm.second))
-                    CV_Error(Error::StsError, dir + ": cannot write " + file);
+                const String name = cv::format("%04d.png", fm.first);
+                detail::writeImageFile((od / name).string(), fm.second,
+                                       (target / obj.first / name).string());
             }
         }
     });
@@ -624,6 +575,71 @@ bool isImageFile(const fs::path& p)
 
 } // namespace
 
+namespace detail {
+
+String FramePattern::expand(int index) const
+{
+    CV_Assert(index >= 0);
+    String digits = std::to_string(index);
+    if ((int)digits.size() < width)
+        digits.insert(0, width - digits.size(), zeroPad ? '0' : ' ');
+    return prefix + digits + suffix;
+}
+
+FramePattern parseFramePattern(const String& pattern)
+{
+    const String what = "'" + pattern + "': not a frame pattern: ";
+    const String expected = " (expected one %d, %Nd or %0Nd, as in frames/%04d.png; %% for a "
+                            "literal %)";
+    FramePattern p;
+    bool converted = false;
+    for (size_t i = 0; i < pattern.size(); i++)
+    {
+        String& literal = converted ? p.suffix : p.prefix;
+        if (pattern[i] != '%')
+        {
+            literal += pattern[i];
+            continue;
+        }
+        if (i + 1 < pattern.size() && pattern[i + 1] == '%')
+        {
+            literal += '%';
+            i++;
+            continue;
+        }
+        // %[0][N]d; the conversion spans [i, j].
+        size_t j = i + 1;
+        const bool zero = j < pattern.size() && pattern[j] == '0';
+        if (zero)
+            j++;
+        const size_t digitsStart = j;
+        while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9')
+            j++;
+        const String digits = pattern.substr(digitsStart, j - digitsStart);
+        if (j >= pattern.size() || pattern[j] != 'd' || (zero && !digits.empty() &&
+                                                          digits[0] == '0'))
+        {
+            const size_t shown = std::min(pattern.size(), j + 1) - i;
+            CV_Error(Error::StsBadArg, what + "'" + pattern.substr(i, shown) + "' is not an "
+                     "integer conversion" + expected);
+        }
+        if (converted)
+            CV_Error(Error::StsBadArg, what + "more than one conversion" + expected);
+        if (digits.size() > 2 || (!digits.empty() && std::stoi(digits) > kMaxFramePatternWidth))
+            CV_Error(Error::StsBadArg, what + "width " + digits + cv::format(" is over %d",
+                     kMaxFramePatternWidth) + expected);
+        p.width = digits.empty() ? 0 : std::stoi(digits);
+        p.zeroPad = zero;
+        converted = true;
+        i = j;
+    }
+    if (!converted)
+        CV_Error(Error::StsBadArg, what + "no integer conversion" + expected);
+    return p;
+}
+
+} // namespace detail
+
 Ptr<FrameSource> FrameSource::open(const String& input)
 {
     if (input.empty())
@@ -640,21 +656,20 @@ Ptr<FrameSource> FrameSource::open(const String& input)
             CV_Error(Error::StsObjectNotFound, input + ": folder holds no image");
         return makePtr<ImageListSource>(input, files);
     }
-    if (input.find('%') != String::npos)
+    if (input.find('%') != String::npos && !fs::exists(input))
     {
+        // Expanded here, never by printf or by VideoCapture (whose image sequences would use
+        // the user's text as a format): a bad pattern is an error before any file is looked at.
+        const detail::FramePattern pattern = detail::parseFramePattern(input);
         std::vector<String> files;
-        for (int i = 0;; i++)
+        for (int i = 0; i < std::numeric_limits<int>::max(); i++)
         {
-            const String f = cv::format(input.c_str(), i);
+            const String f = pattern.expand(i);
             if (!fs::exists(f))
             {
-                if (i == 0)
-                {
-                    // Patterns may start at 1 (ffmpeg's default).
-                    const String f1 = cv::format(input.c_str(), 1);
-                    if (fs::exists(f1))
-                        continue;
-                }
+                // Patterns may start at 1 (ffmpeg's default).
+                if (i == 0 && fs::exists(pattern.expand(1)))
+                    continue;
                 break;
             }
             files.push_back(f);

@@ -6,9 +6,11 @@
 
 #include "precomp.hpp"
 
+#include "atomic_write.hpp"
+
 #include <cstdint>
 #include <cstring>
-#include <fstream>
+#include <sstream>
 
 namespace cv {
 namespace augocc {
@@ -324,9 +326,7 @@ void writeMeshPly(const String& path, const Mesh& mesh)
         CV_Assert(first == 1 && "binary_little_endian output assumes a little-endian host");
     }
     writeAtomically(path, [&](const String& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        if (!out)
-            CV_Error(Error::StsError, path + ": cannot open for writing");
+        std::ostringstream out;
         out << "ply\nformat binary_little_endian 1.0\ncomment written by augocc\n";
         out << "element vertex " << nv << "\n";
         out << "property float x\nproperty float y\nproperty float z\n";
@@ -367,9 +367,8 @@ void writeMeshPly(const String& path, const Mesh& mesh)
             put(idx, sizeof(idx));
         }
         out.write(buf.data(), (std::streamsize)buf.size());
-        out.close();
-        if (!out)
-            CV_Error(Error::StsError, path + ": write failed");
+        const String bytes = out.str();
+        detail::writeFileBytes(tmp, bytes.data(), bytes.size(), path);
     });
 }
 

@@ -5,6 +5,8 @@
 
 #include "precomp.hpp"
 
+#include "atomic_write.hpp"
+
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -39,12 +41,10 @@ public:
                    !top.parent_path().empty() && !fs::exists(top.parent_path()))
                 top = top.parent_path();
             madeDir_ = top.string();
-            fs::create_directories(p.parent_path());
+            detail::createDirectories(p.parent_path().string());
         }
-        const String name = "." + p.stem().string() +
-                            cv::format(".tmp%d", (int)(cv::getTickCount() & 0xffffff)) +
-                            p.extension().string();
-        tmp_ = (p.parent_path() / name).string();
+        detail::sweepStaleTemporaries(path);
+        tmp_ = detail::tmpNameFor(path);
     }
     ~PendingOutput()
     {
@@ -65,12 +65,11 @@ public:
     const String& tmp() const { return tmp_; }
     void commit()
     {
+        // A folder replaces a folder, a file a file (rename); a file and a folder, not.
         std::error_code ec;
-        if (fs::exists(path_))
+        if (fs::exists(path_) && fs::is_directory(path_) != fs::is_directory(tmp_))
             fs::remove_all(path_, ec);
-        fs::rename(tmp_, path_, ec);
-        if (ec)
-            CV_Error(Error::StsError, path_ + ": cannot rename from " + tmp_ + ": " + ec.message());
+        detail::commitTemporary(tmp_, path_);
         committed_ = true;
     }
 
@@ -87,14 +86,17 @@ Matx33d groundRotation(const GroundFrame& g)
                    g.back[1], g.back[2]);
 }
 
-void writeImage(const String& file, const Mat& img)
+// `name` in the temporary folder `tmp` of the output folder `shown` (errors name the latter).
+void writeImage(const String& tmp, const String& shown, const String& name, const Mat& img)
 {
-    if (!cv::imwrite(file, img))
-        CV_Error(Error::StsError, file + ": cannot write image");
+    detail::writeImageFile((fs::path(tmp) / name).string(), img,
+                           (fs::path(shown) / name).string());
 }
 
 VideoWriter openVideo(const String& tmp, const String& shown, double fps, Size size)
 {
+    // FFmpeg says nothing of why it cannot open a file: a folder we cannot write fails here.
+    detail::checkCreatable(tmp, shown);
     VideoWriter writer;
     // H.264 first (plays everywhere), MPEG-4 part 2 when this FFmpeg cannot encode it.
     for (const char* cc : {"avc1", "H264", "mp4v"})
@@ -182,15 +184,16 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
     if (!options.virtualLayerDir.empty())
         layerOut.reset(new PendingOutput(options.virtualLayerDir));
     if (!video)
-        fs::create_directories(out.tmp());
+        detail::createDirectories(out.tmp(), output);
     const std::vector<String> objects = clones.objectNames();
     if (mattesOut)
         for (const String& o : objects)
-            fs::create_directories(fs::path(mattesOut->tmp()) / o);
+            detail::createDirectories((fs::path(mattesOut->tmp()) / o).string(),
+                                      options.mattesDir);
     if (depthOut)
-        fs::create_directories(depthOut->tmp());
+        detail::createDirectories(depthOut->tmp(), options.depthDir);
     if (layerOut)
-        fs::create_directories(layerOut->tmp());
+        detail::createDirectories(layerOut->tmp(), options.virtualLayerDir);
 
     Compositor::Params cp;
     cp.supersample = options.supersample;
@@ -219,28 +222,34 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
         if (video)
             writer.write(result);
         else
-            writeImage((fs::path(out.tmp()) / name).string(), result);
+            writeImage(out.tmp(), output, name, result);
         if (layerOut)
-            writeImage((fs::path(layerOut->tmp()) / name).string(), layer);
+            writeImage(layerOut->tmp(), options.virtualLayerDir, name, layer);
         if (depthOut)
-            writeImage((fs::path(depthOut->tmp()) / name).string(), encodeDepth(depth, enc));
+            writeImage(depthOut->tmp(), options.depthDir, name, encodeDepth(depth, enc));
         if (mattesOut)
             for (const String& o : objects)
             {
                 clones.render(o, f, cam, rec.imageSize, matte);
-                writeImage((fs::path(mattesOut->tmp()) / o / name).string(), matte);
+                writeImage((fs::path(mattesOut->tmp()) / o).string(),
+                           (fs::path(options.mattesDir) / o).string(), name, matte);
             }
         if (options.progress)
             options.progress(f - first + 1, end - first);
     }
     if (video)
-        writer.release();
-    if (depthOut)
     {
-        FileStorage fsd((fs::path(depthOut->tmp()) / "depth.yml").string(), FileStorage::WRITE);
-        fsd << "description" << "z = (value - 1) / scale + offset; value 0 = nothing";
-        fsd << "scale" << enc.scale << "offset" << enc.offset;
+        writer.release();
+        detail::checkVideoFile(out.tmp(), end - first, output);
     }
+    if (depthOut)
+        detail::writeStorageFile((fs::path(depthOut->tmp()) / "depth.yml").string(),
+                                 [&](FileStorage& fsd) {
+                                     fsd << "description"
+                                         << "z = (value - 1) / scale + offset; value 0 = nothing";
+                                     fsd << "scale" << enc.scale << "offset" << enc.offset;
+                                 },
+                                 (fs::path(options.depthDir) / "depth.yml").string());
     out.commit();
     if (mattesOut)
         mattesOut->commit();
@@ -313,7 +322,7 @@ RunResult runPipeline(const RunOptions& o)
     } guard;
     if (!fs::exists(o.outDir))
         guard.dir = o.outDir;
-    fs::create_directories(o.outDir);
+    detail::createDirectories(o.outDir);
     const fs::path dir(o.outDir);
 
     timer.start();
@@ -431,7 +440,7 @@ DemoResult runDemo(const DemoOptions& o)
 {
     DemoResult res;
     const fs::path dir(o.outDir);
-    fs::create_directories(dir / "input");
+    detail::createDirectories((dir / "input").string());
     SceneSynthesizer::Params sp;
     sp.frames = o.frames;
     sp.imageSize = o.imageSize;
@@ -447,10 +456,9 @@ DemoResult runDemo(const DemoOptions& o)
     // The input: frames as PNG (lossless), key-frame masks, the scene file.
     const String framesDir = (dir / "input" / "frames").string();
     writeAtomically(framesDir, [&](const String& tmp) {
-        fs::create_directories(tmp);
+        detail::createDirectories(tmp, framesDir);
         for (size_t f = 0; f < scene.frames.size(); f++)
-            writeImage((fs::path(tmp) / cv::format("%04d.png", (int)f)).string(),
-                       scene.frames[f]);
+            writeImage(tmp, framesDir, cv::format("%04d.png", (int)f), scene.frames[f]);
     });
     const String masksDir = (dir / "input" / "masks").string();
     writeMasks(masksDir, scene.keyFrameMasks);
@@ -539,7 +547,9 @@ DemoResult runDemo(const DemoOptions& o)
     }
     res.contactSheetPath = (dir / "contact_sheet.png").string();
     const Mat sheetImg = makeContactSheet(sheet, captions, (int)before.size(), 320);
-    writeAtomically(res.contactSheetPath, [&](const String& tmp) { writeImage(tmp, sheetImg); });
+    writeAtomically(res.contactSheetPath, [&](const String& tmp) {
+        detail::writeImageFile(tmp, sheetImg, res.contactSheetPath);
+    });
     return res;
 }
 

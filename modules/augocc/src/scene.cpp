@@ -8,6 +8,8 @@
 #include "ground_plane.hpp"
 #include "io_internal.hpp"
 
+#include "atomic_write.hpp"
+
 #include <filesystem>
 #include <set>
 #include <opencv2/imgcodecs.hpp>
@@ -270,10 +272,7 @@ VirtualScene readScene(const String& path)
 
 void writeScene(const String& path, const VirtualScene& scene)
 {
-    writeAtomically(path, [&](const String& tmp) {
-        FileStorage out(tmp, FileStorage::WRITE);
-        if (!out.isOpened())
-            CV_Error(Error::StsError, path + ": cannot open for writing");
+    detail::writeStorageAtomically(path, [&](FileStorage& out) {
         const fs::path dir = fs::path(path).parent_path();
         out << "objects" << "[";
         for (const SceneObject& o : scene.objects)
@@ -310,7 +309,6 @@ void writeScene(const String& path, const VirtualScene& scene)
             out << "}";
         }
         out << "]";
-        out.release();
     });
 }
 

@@ -5,9 +5,10 @@
 
 #include "precomp.hpp"
 #include "sfm_detail.hpp"
+#include "atomic_write.hpp"
 
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <Eigen/Geometry>
 
 namespace cv {
@@ -27,19 +28,17 @@ Mat checkColors(InputArray colors, int rows, const char* what)
     return c.reshape(3, rows);
 }
 
-void openOrThrow(std::ofstream& out, const String& path)
+// Text is made in memory and written with checked I/O (atomic_write.hpp): an ofstream on a
+// full disk says only that it failed, not why.
+void startText(std::ostringstream& out)
 {
-    out.open(path);
-    if (!out)
-        CV_Error(Error::StsError, "cannot write " + path);
     out.precision(17);
 }
 
-void closeOrThrow(std::ofstream& out, const String& path)
+void writeText(const std::ostringstream& out, const String& tmp, const String& shown)
 {
-    out.close();
-    if (!out)
-        CV_Error(Error::StsError, "write error on " + path);
+    const String text = out.str();
+    detail::writeFileBytes(tmp, text.data(), text.size(), shown);
 }
 
 } // namespace
@@ -55,10 +54,7 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
     if (!(orthoDistanceRatio > 1))
         CV_Error(Error::StsBadArg, "writeColmapModel: orthoDistanceRatio must be > 1");
     const Mat colors = checkColors(colorsArg, rec.points.rows, "writeColmapModel");
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec)
-        CV_Error(Error::StsError, "cannot create " + dir + ": " + ec.message());
+    detail::createDirectories(dir);
     const int P = rec.points.rows;
     Vec3d c;
     const double radius = detail::rmsRadius(rec.points, &c);
@@ -84,8 +80,8 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
     std::vector<double> errSum(P, 0.0);
 
     writeAtomically(dir + "/images.txt", [&](const String& tmp) {
-        std::ofstream out;
-        openOrThrow(out, tmp);
+        std::ostringstream out;
+        startText(out);
         out << "# Image list with two lines of data per image:\n"
                "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
                "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
@@ -124,11 +120,11 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
             }
             out << '\n';
         }
-        closeOrThrow(out, tmp);
+        writeText(out, tmp, dir + "/images.txt");
     });
     writeAtomically(dir + "/cameras.txt", [&](const String& tmp) {
-        std::ofstream out;
-        openOrThrow(out, tmp);
+        std::ostringstream out;
+        startText(out);
         out << "# Camera list with one line of data per camera:\n"
                "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
         if (rec.model == SCALED_ORTHOGRAPHIC)
@@ -138,11 +134,11 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
             out << cam.frame + 1 << " PINHOLE " << rec.imageSize.width << ' '
                 << rec.imageSize.height << ' ' << cam.K(0, 0) << ' ' << cam.K(1, 1) << ' '
                 << cam.K(0, 2) + 0.5 << ' ' << cam.K(1, 2) + 0.5 << '\n';
-        closeOrThrow(out, tmp);
+        writeText(out, tmp, dir + "/cameras.txt");
     });
     writeAtomically(dir + "/points3D.txt", [&](const String& tmp) {
-        std::ofstream out;
-        openOrThrow(out, tmp);
+        std::ostringstream out;
+        startText(out);
         out << "# 3D point list with one line of data per point:\n"
                "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n";
         for (int p = 0; p < P; p++)
@@ -160,7 +156,7 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
                 out << ' ' << tr.first << ' ' << tr.second;
             out << '\n';
         }
-        closeOrThrow(out, tmp);
+        writeText(out, tmp, dir + "/points3D.txt");
     });
 }
 
@@ -172,8 +168,8 @@ void writePointsPly(const String& path, const Reconstruction& rec, InputArray co
     const Mat colors = checkColors(colorsArg, rec.points.rows, "writePointsPly");
     const int n = rec.validPointCount();
     writeAtomically(path, [&](const String& tmp) {
-        std::ofstream out;
-        openOrThrow(out, tmp);
+        std::ostringstream out;
+        startText(out);
         out << "ply\nformat ascii 1.0\ncomment augocc reconstruction points\n"
             << "element vertex " << n << "\nproperty double x\nproperty double y\n"
             << "property double z\n";
@@ -193,7 +189,7 @@ void writePointsPly(const String& path, const Reconstruction& rec, InputArray co
             }
             out << '\n';
         }
-        closeOrThrow(out, tmp);
+        writeText(out, tmp, path);
     });
 }
 

@@ -6,6 +6,8 @@
 
 #include "precomp.hpp"
 
+#include "atomic_write.hpp"
+
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -23,12 +25,12 @@ const int kWriteBatch = 8;
 
 void writeImage(const String& path, const Mat& img)
 {
-    if (!imwrite(path, img))
-        CV_Error(Error::StsError, path + ": cannot write");
+    detail::writeImageFile(path, img, path);
 }
 
 void writeVideo(const String& path, const std::vector<Mat>& frames)
 {
+    detail::checkCreatable(path, path);
     // H.264 first (plays everywhere), MPEG-4 part 2 when this FFmpeg has no H.264 encoder.
     VideoWriter writer;
     for (const char* cc : {"avc1", "H264", "mp4v"})
@@ -43,6 +45,7 @@ void writeVideo(const String& path, const std::vector<Mat>& frames)
     for (const Mat& f : frames)
         writer.write(f);
     writer.release();
+    detail::checkVideoFile(path, (int)frames.size(), path);
 }
 
 // Depth as 16-bit PNG: value = round(z * scale), 0 where nothing; scale a power of ten chosen so
@@ -64,11 +67,10 @@ void writeDepth(const fs::path& dir, const std::vector<Mat>& depth)
         scale *= 10;
     while (maxZ * scale >= 65000 && scale > 1e-6)
         scale /= 10;
-    {
-        FileStorage fs((dir / "depth.yml").string(), FileStorage::WRITE);
+    detail::writeStorageFile((dir / "depth.yml").string(), [&](FileStorage& fs) {
         fs << "scale" << scale;
         fs << "description" << "camera-space z = value / scale; 0 = nothing (infinite)";
-    }
+    }, (dir / "depth.yml").string());
     parallel_for_(Range(0, (int)depth.size()), [&](const Range& r) {
         for (int f = r.start; f < r.end; f++)
         {
@@ -132,26 +134,25 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
             for (size_t i = 0; i < scene.objectNames.size(); i++)
                 writeMeshPly((tmp / "gt" / "meshes" / (scene.objectNames[i] + ".ply")).string(),
                              scene.objectMeshes[i]);
-            FileStorage info((tmp / "gt" / "synth.yml").string(), FileStorage::WRITE);
-            if (!info.isOpened())
-                CV_Error(Error::StsError, dir + ": cannot write gt/synth.yml");
-            info << "model" << cameraModelName(p.model);
-            info << "frames" << p.frames;
-            info << "seed" << format("%llu", (unsigned long long)p.seed);
-            info << "noise_sigma" << p.noiseSigma;
-            info << "partial_fraction" << p.partialFraction;
-            info << "outlier_fraction" << p.outlierFraction;
-            info << "distance_ratio" << p.distanceRatio;
-            info << "frame_supersample" << p.frameSupersample;
-            info << "orbit_degrees" << p.orbitDegrees;
-            info << "elevation_degrees" << p.elevationDegrees;
-            info << "objects" << "[";
-            for (const String& name : scene.objectNames)
-                info << name;
-            info << "]";
-            info << "key_frames" << Mat(scene.keyFrames).reshape(1, 1);
-            info << "outlier_tracks" << Mat(scene.outlierTrack).reshape(1, 1);
-            info.release();
+            const String synthYml = (tmp / "gt" / "synth.yml").string();
+            detail::writeStorageFile(synthYml, [&](FileStorage& info) {
+                info << "model" << cameraModelName(p.model);
+                info << "frames" << p.frames;
+                info << "seed" << format("%llu", (unsigned long long)p.seed);
+                info << "noise_sigma" << p.noiseSigma;
+                info << "partial_fraction" << p.partialFraction;
+                info << "outlier_fraction" << p.outlierFraction;
+                info << "distance_ratio" << p.distanceRatio;
+                info << "frame_supersample" << p.frameSupersample;
+                info << "orbit_degrees" << p.orbitDegrees;
+                info << "elevation_degrees" << p.elevationDegrees;
+                info << "objects" << "[";
+                for (const String& name : scene.objectNames)
+                    info << name;
+                info << "]";
+                info << "key_frames" << Mat(scene.keyFrames).reshape(1, 1);
+                info << "outlier_tracks" << Mat(scene.outlierTrack).reshape(1, 1);
+            }, synthYml);
         });
     }
     catch (const fs::filesystem_error& e)

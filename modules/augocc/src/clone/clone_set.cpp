@@ -4,6 +4,7 @@
 // CloneSet: rendering (matte + depth), file I/O, PLY export and the mattes folder.
 
 #include "precomp.hpp"
+#include "atomic_write.hpp"
 #include "clone/clone_set.hpp"
 #include "clone/clone_codec.hpp"
 #include "io_internal.hpp"
@@ -153,10 +154,7 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
 
 void CloneSetImpl::save(const String& path) const
 {
-    writeAtomically(path, [&](const String& tmp) {
-        FileStorage fs(tmp, FileStorage::WRITE);
-        if (!fs.isOpened())
-            CV_Error(Error::StsError, path + ": cannot open for writing");
+    detail::writeStorageAtomically(path, [&](FileStorage& fs) {
         fs << "format" << "augocc_clones";
         fs << "version" << 1;
         fs << "patch_rule" << (patchRule == CloneBuilder::PATCH_BRACKETING ? "bracketing"
@@ -203,7 +201,6 @@ void CloneSetImpl::save(const String& path) const
             fs << "}";
         }
         fs << "]";
-        fs.release();
     });
 }
 
@@ -351,18 +348,18 @@ void writeMattes(const String& dir, const CloneSet& clones, const Reconstruction
         namespace fsys = std::filesystem;
         fsys::path target(depthDir);
         if (target.has_parent_path())
-            fsys::create_directories(target.parent_path());
+            detail::createDirectories(target.parent_path().string());
         writeAtomically(depthDir, [&](const String& tmp) {
-            fsys::create_directories(tmp);
+            detail::createDirectories(tmp, depthDir);
             for (const auto& o : depth)
             {
                 const fsys::path od = fsys::path(tmp) / o.first;
-                fsys::create_directories(od);
+                detail::createDirectories(od.string(), (target / o.first).string());
                 for (const auto& f : o.second)
                 {
-                    const String file = (od / cv::format("%04d.tiff", f.first)).string();
-                    if (!cv::imwrite(file, f.second))
-                        CV_Error(Error::StsError, depthDir + ": cannot write " + file);
+                    const String name = cv::format("%04d.tiff", f.first);
+                    detail::writeImageFile((od / name).string(), f.second,
+                                           (target / o.first / name).string());
                 }
             }
         });

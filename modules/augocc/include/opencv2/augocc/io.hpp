@@ -109,7 +109,13 @@ class CV_EXPORTS FrameSource
 public:
     virtual ~FrameSource();
     /** @brief Opens the input; throws StsObjectNotFound / StsBadArg naming it when it cannot be
-    opened or holds no frame. */
+    opened or holds no frame.
+
+    An input that names no existing file and holds a '%' is a frame pattern: literal text, `%%`
+    for a literal '%', and exactly one integer conversion `%d`, `%Nd` or `%0Nd` (N <= 10); frame
+    i is the i-th existing file from index 0 (or 1 when index 0 is absent). Any other pattern is
+    StsBadArg naming it. The pattern is expanded by augocc and the files read with imread: it is
+    never used as a printf or VideoCapture format. */
     static Ptr<FrameSource> open(const String& input);
     //! Number of frames (exact for folders and patterns; the container's count for videos).
     virtual int count() const = 0;
@@ -125,8 +131,13 @@ public:
     virtual void seek(int index) = 0;
 };
 
-/** @brief Writes `tmp` by calling `writer(tmpPath)` and renames it to `path` on success; on
-failure removes the temporary and rethrows. Used by every writer of the module (and the CLI). */
+/** @brief Writes `path` all or nothing: `writer(tmpPath)` writes a temporary sibling
+(`.STEM.tmpPID-K.EXT`, same extension), which is fsync'ed (every file and folder under it) and
+renamed onto `path`, then the folder is fsync'ed. On failure the temporary is removed and the
+error rethrown (a std::filesystem error as StsError naming `path` and the OS reason). Temporaries
+of `path` that a killed earlier run left are removed first. `writer` must check its own writes:
+FileStorage and imwrite do not report a full disk (the module's writers write through checked
+calls). Used by every writer of the module (and the CLI). */
 CV_EXPORTS void writeAtomically(const String& path,
                                 const std::function<void(const String& tmpPath)>& writer);
 
