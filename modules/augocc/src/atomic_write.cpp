@@ -312,6 +312,10 @@ void writeStorageFile(const String& file, const std::function<void(FileStorage&)
     if (!storage.isOpened())
         CV_Error(Error::StsError, shown + ": cannot start a FileStorage in memory");
     fill(storage);
+    // A `fill` that released the storage would leave nothing to write: never a valid file.
+    if (!storage.isOpened())
+        CV_Error(Error::StsInternal, shown + ": the FileStorage was released before it was "
+                 "written");
     const String text = storage.releaseAndGetString();
     if (gz)
     {
