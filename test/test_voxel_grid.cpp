@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "test_precomp.hpp"
+#include "test_clone_scenes.hpp"
 #include "voxel_grid.hpp"
 #include "clone/clone_codec.hpp"
 
@@ -12,22 +13,12 @@ using namespace cv;
 using namespace cv::augocc;
 using namespace cv::augocc::detail;
 
+// A camera on an orbit around the origin (test_clone_scenes' orbitCamera, target at the origin).
 Camera lookAtCamera(CameraModel model, double azimuthDeg, double elevationDeg, double dist,
                     Size size, double pixelsPerUnit)
 {
-    const double a = azimuthDeg * CV_PI / 180, e = elevationDeg * CV_PI / 180;
-    const Vec3d C(dist * std::cos(e) * std::sin(a), dist * std::sin(e), dist * std::cos(e) * std::cos(a));
-    const Vec3d f = -C / cv::norm(C);
-    Vec3d x = f.cross(Vec3d(0, 1, 0));
-    x /= cv::norm(x);
-    const Vec3d y = f.cross(x);
-    const Matx33d R(x[0], x[1], x[2], y[0], y[1], y[2], f[0], f[1], f[2]);
-    const Vec3d t = -(R * C);
-    const Point2d pp(size.width / 2.0 - 0.5, size.height / 2.0 - 0.5);
-    if (model == SCALED_ORTHOGRAPHIC)
-        return Camera::orthographic(R, t, pixelsPerUnit, pp);
-    const double fpx = pixelsPerUnit * dist;
-    return Camera::perspective(R, t, Matx33d(fpx, 0, pp.x, 0, fpx, pp.y, 0, 0, 1));
+    return orbitCamera(model, azimuthDeg, elevationDeg, dist, Vec3d(0, 0, 0), size,
+                       pixelsPerUnit, 0);
 }
 
 Mat blobMask(Size size, RNG& rng)
