@@ -312,6 +312,19 @@ Reconstruction readReconstruction(const String& path)
                 if (std::abs(pp(0) - cam.K(0, 2)) > 1e-6 || std::abs(pp(1) - cam.K(1, 2)) > 1e-6)
                     CV_Error(Error::StsBadArg, ci + ": key 'principal_point' differs from K");
             }
+            FileNode dn = c["distortion_coefficients"];
+            if (!dn.empty() && !dn.isNone())
+            {
+                Mat D = readMatKey(c, "distortion_coefficients", ci);
+                if (D.channels() != 1 || (D.rows != 1 && D.cols != 1) ||
+                    (D.depth() != CV_64F && D.depth() != CV_32F))
+                    CV_Error(Error::StsBadSize, ci + cv::format(": key 'distortion_coefficients' "
+                             "must be a 1xN double matrix, got %dx%d ", D.rows, D.cols) +
+                             typeToString(D.type()));
+                Mat D64;
+                D.reshape(1, 1).convertTo(D64, CV_64F);
+                cam.distortion.assign(D64.ptr<double>(), D64.ptr<double>() + D64.cols);
+            }
         }
         rec.cameras.push_back(cam);
     }
@@ -353,6 +366,8 @@ void writeReconstruction(const String& path, const Reconstruction& rec)
                 storage << "s" << c.s;
             else
                 storage << "K" << Mat(c.K);
+            if (!c.distortion.empty())
+                storage << "distortion_coefficients" << Mat(c.distortion).reshape(1, 1);
             storage << "principal_point" << (Mat_<double>(1, 2) << pp.x, pp.y);
             storage << "}";
         }

@@ -52,6 +52,7 @@ Every type, function and file of the module follows these; headers do not restat
 */
 
 #include "opencv2/augocc/camera.hpp"
+#include "opencv2/augocc/lens.hpp"
 #include "opencv2/augocc/io.hpp"
 #include "opencv2/augocc/mesh.hpp"
 #include "opencv2/augocc/scene_synthesizer.hpp"

@@ -4,6 +4,7 @@
 #ifndef OPENCV_AUGOCC_CAMERA_HPP
 #define OPENCV_AUGOCC_CAMERA_HPP
 
+#include <vector>
 #include <opencv2/core.hpp>
 
 namespace cv {
@@ -49,12 +50,34 @@ struct CV_EXPORTS Camera
     Matx33d K = Matx33d::eye();    //!< PERSPECTIVE: intrinsics (fx, skew, cx; 0, fy, cy; 0, 0, 1)
     //! SCALED_ORTHOGRAPHIC: principal point (cx, cy), pixels (PERSPECTIVE: in K)
     Point2d pp = Point2d(0, 0);
+    /** PERSPECTIVE: OpenCV's lens distortion coefficients (k1, k2, p1, p2[, k3[, k4, k5, k6[,
+    s1, s2, s3, s4[, tx, ty]]]]), applied exactly as cv::projectPoints applies them, to the
+    normalised point (Xc.x / Xc.z, Xc.y / Xc.z) before K; 0, 4, 5, 8, 12 or 14 values. Empty
+    (or all zero): an ideal pinhole. */
+    std::vector<double> distortion;
 
     //! Makes a scaled-orthographic camera.
     static Camera orthographic(const Matx33d& R, const Vec3d& t, double s, const Point2d& pp,
                                int frame = 0);
-    //! Makes a perspective camera.
-    static Camera perspective(const Matx33d& R, const Vec3d& t, const Matx33d& K, int frame = 0);
+    //! Makes a perspective camera (distortion: see Camera::distortion).
+    static Camera perspective(const Matx33d& R, const Vec3d& t, const Matx33d& K, int frame = 0,
+                              const std::vector<double>& distortion = std::vector<double>());
+
+    //! True when the camera is PERSPECTIVE with a non-zero distortion coefficient.
+    bool hasDistortion() const;
+    /** @brief Lens distortion of a normalised point (x, y) = (Xc.x / Xc.z, Xc.y / Xc.z): the
+    distorted normalised point, before K (identity without distortion). */
+    Point2d distortNormalized(const Point2d& xy) const;
+    /** @brief Inverse of distortNormalized(): the ideal normalised point whose distortion is `xd`,
+    by Newton iterations to 1e-12 (cv::undistortPoints with a tight criterion). */
+    Point2d undistortNormalized(const Point2d& xd) const;
+    /** @brief A frame pixel to the pixel an ideal pinhole with the same K would see (identity
+    without distortion or for SCALED_ORTHOGRAPHIC). */
+    Point2d undistortPixel(const Point2d& px) const;
+    /** @brief Inverse of undistortPixel(): an ideal pinhole pixel to the frame's pixel. */
+    Point2d distortPixel(const Point2d& px) const;
+    //! The same camera without its lens distortion (an ideal pinhole with the same K).
+    Camera pinhole() const;
 
     //! Principal point (cx, cy) in pixels, whatever the model.
     Point2d principalPoint() const;
@@ -84,10 +107,13 @@ struct CV_EXPORTS Camera
     sqrt(fx * fy) / z for PERSPECTIVE. Used to size voxels and tolerances. */
     double pixelsPerUnit(double z) const;
     /** @brief The 3x4 matrix P with (u, v, w)^T = P * (X, 1)^T; pixel = (u/w, v/w). For
-    SCALED_ORTHOGRAPHIC the last row is (0, 0, 0, 1), i.e. the projection is affine. */
+    SCALED_ORTHOGRAPHIC the last row is (0, 0, 0, 1), i.e. the projection is affine. With lens
+    distortion it is the pinhole part only (the camera of undistortPixel()). */
     Matx34d projectionMatrix() const;
-    //! Throws StsBadArg when R is not a rotation, s or the focal lengths are not positive, or a
-    //! value is not finite. @param what names the source (file, key) in the message.
+    //! Throws StsBadArg when R is not a rotation, s or the focal lengths are not positive, a
+    //! value is not finite, or the distortion has another count than 0, 4, 5, 8, 12 or 14 (or is
+    //! set on a SCALED_ORTHOGRAPHIC camera). @param what names the source (file, key) in the
+    //! message.
     void validate(const String& what = String()) const;
 };
 
