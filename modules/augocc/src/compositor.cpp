@@ -213,6 +213,16 @@ public:
                    const CloneSet& clones, OutputArray result, OutputArray virtualLayer,
                    OutputArray depthOut) CV_OVERRIDE
     {
+        if (camera.hasDistortion())
+        {
+            // The depth test in the lens's ideal view, clones drawn there directly.
+            compositeThroughLens(frameArr, camera, [&](const Mat& black, const Camera& ideal,
+                                                       Mat& layer, Mat* depth) {
+                composite(black, frameIndex, ideal, clones, lensResult_, layer,
+                          depth ? _OutputArray(*depth) : _OutputArray(noArray()));
+            }, result, virtualLayer, depthOut);
+            return;
+        }
         const Mat frame = checkedFrame(frameArr, camera);
         const Size rsz = renderSize(frame.size());
         const FramePlan pl = plan(camera, rsz);
@@ -259,6 +269,63 @@ public:
     void composite(InputArray frameArr, const Camera& camera, InputArray occluderArr,
                    OutputArray result, OutputArray virtualLayer, OutputArray depthOut) CV_OVERRIDE
     {
+        if (camera.hasDistortion())
+        {
+            // The occluder depth (frame pixels) is resampled into the ideal view's render grid
+            // (nearest: depth is not interpolated across edges), the test runs there.
+            const Mat frame0 = checkedFrame(frameArr, camera);
+            Mat occ = occluderArr.getMat();
+            const int k = params_.supersample;
+            const Size fsz = frame0.size(), rsz = renderSize(fsz);
+            if (!occ.empty())
+            {
+                CV_CheckTypeEQ(occ.type(), CV_32FC1, "Compositor: occluder depth must be CV_32F");
+                if (occ.size() != fsz && occ.size() != rsz)
+                    CV_Error(Error::StsBadSize, cv::format("Compositor: occluder depth is %dx%d, "
+                             "expected %dx%d or %dx%d", occ.cols, occ.rows, rsz.width,
+                             rsz.height, fsz.width, fsz.height));
+            }
+            compositeThroughLens(frameArr, camera, [&](const Mat& black, const Camera& ideal,
+                                                       Mat& layer, Mat* depth) {
+                Mat idealOcc;
+                if (!occ.empty())
+                {
+                    const int f = occ.size() == rsz ? k : 1;
+                    const Camera occCam = supersampledCamera(camera, f);
+                    const Camera gridCam = supersampledCamera(ideal, k);
+                    const Size gsz(black.cols * k, black.rows * k);
+                    if (occMap_.size() != gsz || occMapK_ != occCam.K ||
+                        occMapGridK_ != gridCam.K || occMapD_ != camera.distortion)
+                    {
+                        // Render grid of the ideal view -> occluder pixel (cached per lens).
+                        const Matx33d Hi = gridCam.K.inv();
+                        occMap_.create(gsz, CV_32FC2);
+                        parallel_for_(Range(0, gsz.height), [&](const Range& r) {
+                            for (int y = r.start; y < r.end; y++)
+                            {
+                                Vec2f* row = occMap_.ptr<Vec2f>(y);
+                                for (int x = 0; x < gsz.width; x++)
+                                {
+                                    const Vec3d n = Hi * Vec3d(x, y, 1);
+                                    const Point2d p = occCam.distortPixel(Point2d(
+                                        occCam.K(0, 0) * n[0] + occCam.K(0, 1) * n[1] + occCam.K(0, 2),
+                                        occCam.K(1, 1) * n[1] + occCam.K(1, 2)));
+                                    row[x] = Vec2f((float)p.x, (float)p.y);
+                                }
+                            }
+                        });
+                        occMapK_ = occCam.K;
+                        occMapGridK_ = gridCam.K;
+                        occMapD_ = camera.distortion;
+                    }
+                    cv::remap(occ, idealOcc, occMap_, noArray(), INTER_NEAREST,
+                              BORDER_CONSTANT, Scalar(std::numeric_limits<float>::infinity()));
+                }
+                composite(black, ideal, idealOcc, lensResult_, layer,
+                          depth ? _OutputArray(*depth) : _OutputArray(noArray()));
+            }, result, virtualLayer, depthOut);
+            return;
+        }
         const Mat frame = checkedFrame(frameArr, camera);
         const int k = params_.supersample;
         const Size fsz = frame.size();
@@ -287,6 +354,112 @@ public:
     }
 
 private:
+    // A frame through a distorted lens: `pinhole` composites a black image of the ideal view
+    // with the ideal camera (virtual layer: straight alpha, BGRA; depth when asked), the layer is
+    // premultiplied, warped into the frame bilinearly (LensView::toFrame) over the rectangle it
+    // covers, and blended over the frame; the depth is warped by the nearest ideal pixel.
+    void compositeThroughLens(InputArray frameArr, const Camera& camera,
+                              const std::function<void(const Mat&, const Camera&, Mat&, Mat*)>&
+                                  pinhole,
+                              OutputArray resultArr, OutputArray layerArr, OutputArray depthOut)
+    {
+        const Mat frame = checkedFrame(frameArr, camera);
+        Ptr<const LensView> view = LensView::get(camera, frame.size());
+        const Size isz = view->idealSize();
+        if (lensBlack_.size() != isz)
+            lensBlack_ = Mat(isz, CV_8UC3, Scalar::all(0));
+        Mat layer, depth;
+        pinhole(lensBlack_, view->idealCamera(camera), layer, depthOut.needed() ? &depth : nullptr);
+        resultArr.create(frame.size(), CV_8UC3);
+        Mat result = resultArr.getMat();
+        frame.copyTo(result);
+        Mat outLayer;
+        if (layerArr.needed())
+        {
+            layerArr.create(frame.size(), CV_8UC4);
+            outLayer = layerArr.getMat();
+            outLayer.setTo(Scalar::all(0));
+        }
+        if (depthOut.needed())
+            view->toFrame(depth, depthOut, INTER_NEAREST,
+                          Scalar(std::numeric_limits<float>::infinity()));
+        Mat alpha;
+        cv::extractChannel(layer, alpha, 3);
+        const Rect ar = cv::boundingRect(alpha);
+        if (ar.area() == 0)
+            return;
+        // The frame rectangle that sees the covered ideal rectangle (its border, sampled).
+        double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+        const int steps = 32;
+        for (int i = 0; i <= steps; i++)
+            for (int side = 0; side < 4; side++)
+            {
+                const double t = (double)i / steps;
+                Point2d q;
+                switch (side)
+                {
+                case 0: q = Point2d(ar.x - 1 + t * (ar.width + 1), ar.y - 1); break;
+                case 1: q = Point2d(ar.x - 1 + t * (ar.width + 1), ar.y + ar.height); break;
+                case 2: q = Point2d(ar.x - 1, ar.y - 1 + t * (ar.height + 1)); break;
+                default: q = Point2d(ar.x + ar.width, ar.y - 1 + t * (ar.height + 1)); break;
+                }
+                const Point2d p = view->idealToFrame(q);
+                x0 = std::min(x0, p.x);
+                y0 = std::min(y0, p.y);
+                x1 = std::max(x1, p.x);
+                y1 = std::max(y1, p.y);
+            }
+        const Rect fr = Rect(Point(cvFloor(x0) - 2, cvFloor(y0) - 2),
+                             Point(cvCeil(x1) + 3, cvCeil(y1) + 3)) &
+                        Rect(Point(), frame.size());
+        if (fr.area() == 0)
+            return;
+        // Premultiplied float layer over the covered rectangle (with a 1-pixel ring of zeros
+        // for the bilinear taps), and the frame map shifted into it.
+        const Rect pr = Rect(ar.x - 1, ar.y - 1, ar.width + 2, ar.height + 2) & Rect(Point(), isz);
+        Mat pre(pr.size(), CV_32FC4);
+        for (int y = 0; y < pr.height; y++)
+        {
+            const uchar* s = layer.ptr<uchar>(pr.y + y) + 4 * pr.x;
+            Vec4f* d = pre.ptr<Vec4f>(y);
+            for (int x = 0; x < pr.width; x++, s += 4)
+            {
+                const float a = s[3] * (1.f / 255.f);
+                d[x] = Vec4f(s[0] * a, s[1] * a, s[2] * a, a);
+            }
+        }
+        Mat map;
+        view->frameMap()(fr).copyTo(map);
+        map -= Scalar((float)pr.x, (float)pr.y);
+        Mat warped;
+        cv::remap(pre, warped, map, noArray(), INTER_LINEAR, BORDER_CONSTANT, Scalar::all(0));
+        parallel_for_(Range(0, fr.height), [&](const Range& r) {
+            for (int y = r.start; y < r.end; y++)
+            {
+                const Vec4f* w = warped.ptr<Vec4f>(y);
+                uchar* o = result.ptr<uchar>(fr.y + y) + 3 * fr.x;
+                const uchar* f = frame.ptr<uchar>(fr.y + y) + 3 * fr.x;
+                uchar* l = outLayer.empty() ? nullptr : outLayer.ptr<uchar>(fr.y + y) + 4 * fr.x;
+                for (int x = 0; x < fr.width; x++, o += 3, f += 3)
+                {
+                    const Vec4f& v = w[x];
+                    if (v[3] <= 0.f)
+                        continue;
+                    const float ia = 1.f - v[3];
+                    for (int ch = 0; ch < 3; ch++)
+                        o[ch] = saturate_cast<uchar>(v[ch] + f[ch] * ia);
+                    if (l)
+                    {
+                        uchar* lp = l + 4 * x;
+                        for (int ch = 0; ch < 3; ch++)
+                            lp[ch] = saturate_cast<uchar>(v[ch] / v[3]);
+                        lp[3] = saturate_cast<uchar>(255.f * v[3]);
+                    }
+                }
+            }
+        });
+    }
+
     // What a frame needs before drawing: the depth range that holds the virtual objects, the
     // camera of the render grid and the part of that grid where the virtual objects can appear.
     struct FramePlan
@@ -1011,6 +1184,11 @@ private:
     Mat frameRoi_;  // the frame under the ROI, guide of the refinement (during composite())
     Mat rgbaUp_, depthUp_, zRoi_, layerRoi_, visFrac_, allColor_;  // per-frame buffers, reused
     Mat cloneOcc_, cloneDepth_, cloneMatte_;  // composite(..., clones, ...), reused
+    // Through a lens: the ideal view's black background and discarded result; the occluder
+    // overload's map from the ideal render grid to the occluder's pixels, and its lens.
+    Mat lensBlack_, lensResult_, occMap_;
+    Matx33d occMapK_, occMapGridK_;
+    std::vector<double> occMapD_;
 };
 
 } // namespace

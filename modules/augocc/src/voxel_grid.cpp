@@ -117,6 +117,9 @@ int64 VoxelGrid::count() const
 
 VoxelProjector VoxelGrid::projector(const Camera& camera, Size imageSize) const
 {
+    // The row walk is the pinhole's: a lens is handled by the ideal view (clone/ideal_space.hpp,
+    // CloneSet::render), never here.
+    CV_Assert(!camera.hasDistortion());
     VoxelProjector p;
     const Matx34d P = camera.projectionMatrix();
     const Matx33d P3(P(0, 0), P(0, 1), P(0, 2), P(1, 0), P(1, 1), P(1, 2), P(2, 0), P(2, 1),

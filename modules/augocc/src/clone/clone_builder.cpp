@@ -5,6 +5,7 @@
 // each pass is in its own file (pass_*.cpp).
 
 #include "precomp.hpp"
+#include "clone/ideal_space.hpp"
 #include "clone/passes.hpp"
 
 namespace cv {
@@ -153,9 +154,23 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
         for (const auto& m : o.second)
             set->add(o.first).masks[m.first] = m.second.clone();
 
-    PassContext ctx(rec, *set, params_);
-    ctx.keyFrameMasks = &bins;
-    ctx.tracks = tracks;
+    // With a lens, the passes run in its ideal pinhole view (clone/ideal_space.hpp).
+    const IdealSpace space = makeIdealSpace(rec, "CloneBuilder::build");
+    ObjectMasks idealBins;
+    Tracks idealTracks;
+    if (space.active())
+    {
+        for (const auto& o : bins)
+            for (const auto& m : o.second)
+                idealBins[o.first][m.first] = space.mask(m.second);
+        if (tracks)
+            idealTracks = space.tracks(*tracks);
+    }
+    const IdealMasks idealMasks(*set, space);
+    PassContext ctx(space.active() ? space.rec : rec, *set, params_);
+    ctx.keyFrameMasks = space.active() ? &idealBins : &bins;
+    ctx.tracks = tracks && space.active() ? &idealTracks : tracks;
+    ctx.inFrame = space.active() ? &space.inFrame : nullptr;
     runPass("box", passBox, *set, ctx);                 // 1. Steps 1-3: points, box, grid
     runPass("carve", passCarve, *set, ctx);             // 2. Step 4: silhouette carving
     runPass("grid growth", passGridGrowth, *set, ctx);  // 3. the hull beyond Step 3's box
@@ -163,7 +178,8 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
         runPass("free space", passFreeSpace, *set, ctx);  // 4. what the tracks show empty
     if (params_.unobserved.enabled)
     {
-        const ObservedSurfaces observed = observeSurfaces(*set, rec, params_.unobserved);
+        const ObservedSurfaces observed = observeSurfaces(*set, ctx.rec, params_.unobserved,
+                                                          ctx.inFrame);
         ctx.observed = &observed;
         runPass("unobserved", passUnobserved, *set, ctx);  // 5. what no frame sees
         ctx.observed = nullptr;
@@ -180,7 +196,10 @@ void CloneBuilderImpl::addKeyFrame(CloneSet& clones, const Reconstruction& rec,
     Mat m = mask.getMat();
     checkMask(m, rec, object, frame);
     obj.masks[frame] = m > 127;
-    PassContext ctx(rec, set, params_);
+    const IdealSpace space = makeIdealSpace(rec, "CloneBuilder::addKeyFrame");
+    const IdealMasks idealMasks(set, space);
+    PassContext ctx(space.active() ? space.rec : rec, set, params_);
+    ctx.inFrame = space.active() ? &space.inFrame : nullptr;
     ctx.carveFrame = frame;
     passCarve(obj, ctx);    // Step 4 with the new key frame
     passPatches(obj, ctx);  // Step 5
@@ -229,12 +248,27 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
                 CV_Error(Error::StsBadArg, cv::format("CloneBuilder::refine: object '%s': key "
                          "frame %d has no camera", o.first.c_str(), m.first));
 
-    PassContext ctx(rec, set, params_);
+    const IdealSpace space = makeIdealSpace(rec, "CloneBuilder::refine");
+    if (space.active())
+    {
+        std::vector<int> used(frames.size(), 0);
+        for (const Camera& cam : rec.cameras)
+            used[cam.frame] = 1;
+        parallel_for_(Range(0, (int)frames.size()), [&](const Range& r) {
+            for (int f = r.start; f < r.end; f++)
+                if (used[f])
+                    frames[f] = space.image(frames[f]);
+        });
+    }
+    const IdealMasks idealMasks(set, space);
+    PassContext ctx(space.active() ? space.rec : rec, set, params_);
+    ctx.inFrame = space.active() ? &space.inFrame : nullptr;
     std::map<String, int64> carved;
     for (int round = 0; round < params_.photo.rounds; round++)
     {
         // Each round sees the other clones as the last round left them.
-        const PhotoViews views = preparePhotoViews(set, rec, frames, params_.photo);
+        const PhotoViews views = preparePhotoViews(set, ctx.rec, frames, params_.photo,
+                                                   ctx.inFrame);
         ctx.photo = &views;
         int64 roundCarved = 0;
         for (const String& name : set.objectNames())

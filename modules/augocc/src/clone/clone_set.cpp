@@ -117,6 +117,25 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
     if (imageSize.width <= 0 || imageSize.height <= 0)
         CV_Error(Error::StsBadSize, cv::format("clones: render: bad image size %dx%d",
                                                imageSize.width, imageSize.height));
+    if (camera.hasDistortion())
+    {
+        // Drawn in the lens's ideal pinhole view and warped into the frame: the matte by its
+        // coverage (bilinear, half a pixel), the depth by the nearest ideal pixel.
+        Ptr<const LensView> view = LensView::get(camera, imageSize);
+        const Camera ideal = view->idealCamera(camera);
+        Mat m, d;
+        render(object, frame, ideal, view->idealSize(), m, depth.needed() ? d : noArray());
+        if (matte.needed())
+        {
+            Mat w;
+            view->toFrame(m, w, INTER_LINEAR, Scalar(0));
+            compare(w, 127, matte, CMP_GT);
+        }
+        if (depth.needed())
+            view->toFrame(d, depth, INTER_NEAREST,
+                          Scalar(std::numeric_limits<float>::infinity()));
+        return;
+    }
     const VoxelProjector proj = o.grid.projector(camera, imageSize);
     std::vector<VoxelList> lists(1);
     lists[0].ijk = o.surface.ijk.data();

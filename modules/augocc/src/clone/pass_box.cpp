@@ -85,7 +85,7 @@ namespace {
 // every silhouette of this object and of the others (it cannot be the object's), else the number
 // of key frames whose silhouette of this object holds it.
 int silhouetteVotes(const Reconstruction& rec, const ObjectMasks& all, const String& object,
-                    const Tracks* tracks, int p, const Vec3d& X)
+                    const Tracks* tracks, int p, const Vec3d& X, const Mat* inFrame)
 {
     const FrameMasks& masks = all.at(object);
     const Rect img(Point(0, 0), rec.imageSize);
@@ -97,7 +97,7 @@ int silhouetteVotes(const Reconstruction& rec, const ObjectMasks& all, const Str
             continue;
         const Point2d uv = rec.project(f, X);
         const Point px(cvRound(uv.x), cvRound(uv.y));
-        if (!img.contains(px))
+        if (!img.contains(px) || (inFrame && !inFrame->at<uchar>(px)))
         {
             if (tracks)
                 return -1;  // seen in the frame but projects off it: inconsistent point
@@ -132,7 +132,7 @@ int silhouetteVotes(const Reconstruction& rec, const ObjectMasks& all, const Str
 // silhouette), held by this object's silhouettes in at least as many key frames as by any other's.
 std::vector<Vec3d> clusterPoints(const Reconstruction& rec, const ObjectMasks& all,
                                  const String& object, const Tracks* tracks,
-                                 std::vector<int>* indices = nullptr)
+                                 const Mat* inFrame, std::vector<int>* indices = nullptr)
 {
     std::vector<Vec3d> out;
     if (rec.points.empty())
@@ -143,13 +143,13 @@ std::vector<Vec3d> clusterPoints(const Reconstruction& rec, const ObjectMasks& a
         if (!rec.hasPoint(p))
             continue;
         const Vec3d X = rec.point(p);
-        const int mine = silhouetteVotes(rec, all, object, tracks, p, X);
+        const int mine = silhouetteVotes(rec, all, object, tracks, p, X, inFrame);
         if (mine <= 0)
             continue;
         bool best = true;
         for (const auto& other : all)
             if (other.first != object &&
-                silhouetteVotes(rec, all, other.first, tracks, p, X) > mine)
+                silhouetteVotes(rec, all, other.first, tracks, p, X, inFrame) > mine)
             {
                 best = false;
                 break;
@@ -582,7 +582,7 @@ int64 passBox(ObjectClone& obj, const PassContext& ctx)
     const Reconstruction& rec = ctx.rec;
     obj.points.clear();
     std::vector<Vec3d> pts = clusterPoints(rec, *ctx.keyFrameMasks, obj.name, ctx.tracks,
-                                           &obj.points);
+                                           ctx.inFrame, &obj.points);
     const Matx33d R = orientationFor(rec, pts, p);
     Box box;
     if ((int)pts.size() >= p.minPoints)

@@ -35,6 +35,8 @@ Mat keepMask(const ObjectClone& obj, const PassContext& ctx, int frame)
     Mat keep = obj.masks.at(frame).clone();
     if (ctx.params.occlusionAware)
         keep |= unknownMask(ctx.clones, obj.name, frame, ctx.rec.camera(frame), keep.size());
+    if (ctx.inFrame)
+        keep.setTo(Scalar(255), *ctx.inFrame == 0);  // beyond the frame: unknown
     return keep;
 }
 

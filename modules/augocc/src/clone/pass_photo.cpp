@@ -303,7 +303,7 @@ int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
 
 PhotoViews preparePhotoViews(const CloneSetImpl& clones, const Reconstruction& rec,
                              const std::vector<Mat>& frames,
-                             const CloneBuilder::PhotoParams& p)
+                             const CloneBuilder::PhotoParams& p, const Mat* inFrame)
 {
     const std::vector<String> names = clones.objectNames();
     PhotoViews views;
@@ -332,14 +332,17 @@ PhotoViews preparePhotoViews(const CloneSetImpl& clones, const Reconstruction& r
     }
     // Objects hide each other: per camera, the nearest depth of the other clones as they
     // stand (the renderer of the compositor; objects only shrink, so this is conservative).
-    if (no > 1)
+    // Where the ideal view of a lens sees beyond the frame (inFrame), every voxel counts as
+    // hidden (depth -inf): that view has no colour for it.
+    if (no > 1 || inFrame)
         parallel_for_(Range(0, nc), [&](const Range& r) {
             std::vector<Mat> depth(no);
             for (int c = r.start; c < r.end; c++)
             {
                 const Camera& cam = *use[c];
-                for (int o = 0; o < no; o++)
-                    clones.render(names[o], cam.frame, cam, size, noArray(), depth[o]);
+                if (no > 1)
+                    for (int o = 0; o < no; o++)
+                        clones.render(names[o], cam.frame, cam, size, noArray(), depth[o]);
                 for (int a = 0; a < no; a++)
                 {
                     const Rect& roi = ov[a]->roi[c];
@@ -349,6 +352,9 @@ PhotoViews preparePhotoViews(const CloneSetImpl& clones, const Reconstruction& r
                     for (int o = 0; o < no; o++)
                         if (o != a)
                             cv::min(m, depth[o](roi), m);
+                    if (inFrame)
+                        m.setTo(Scalar(-std::numeric_limits<float>::infinity()),
+                                (*inFrame)(roi) == 0);
                     ov[a]->others[c] = m;
                 }
             }

@@ -25,7 +25,8 @@ namespace augocc {
 namespace detail {
 
 ObservedSurfaces observeSurfaces(const CloneSetImpl& clones, const Reconstruction& rec,
-                                 const CloneBuilder::UnobservedParams& params)
+                                 const CloneBuilder::UnobservedParams& params,
+                                 const Mat* inFrame)
 {
     std::vector<const Camera*> cams = evenlySpacedCameras(rec, params.views);
     std::set<int> have;
@@ -72,7 +73,8 @@ ObservedSurfaces observeSurfaces(const CloneSetImpl& clones, const Reconstructio
                     unpackVoxel(obj.surface.ijk[q], i, j, k);
                     Point px;
                     if (!projs[n].centrePixel(i, j, k, px) || px.x < 0 || px.y < 0 ||
-                        px.x >= size.width || px.y >= size.height)
+                        px.x >= size.width || px.y >= size.height ||
+                        (inFrame && !inFrame->at<uchar>(px)))
                         continue;
                     const double z = projs[n].Z.dot(Vec3d(i, j, k)) + projs[n].z0;
                     if (z <= zbuf.at<float>(px) + tol)

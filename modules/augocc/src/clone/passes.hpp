@@ -63,6 +63,9 @@ struct PassContext
     const ObservedSurfaces* observed = nullptr;
     //! passPhoto: the compared frames and the other clones' depth, made by preparePhotoViews().
     const PhotoViews* photo = nullptr;
+    /** With lens distortion (clone/ideal_space.hpp): CV_8U of rec.imageSize, 255 where the frame
+    sees; the rest of the ideal image is unknown, as pixels off the image. Null: all seen. */
+    const Mat* inFrame = nullptr;
 };
 
 //! Steps 1-3 (the paper's Section 6): obj.points, obj.box, obj.centre and the full grid. obj.masks
@@ -88,7 +91,8 @@ struct ObservedSurfaces
 //! What passUnobserved needs: every clone's surface drawn into the frames it asks, at once.
 CV_EXPORTS ObservedSurfaces observeSurfaces(const CloneSetImpl& clones,
                                             const Reconstruction& rec,
-                                            const CloneBuilder::UnobservedParams& params);
+                                            const CloneBuilder::UnobservedParams& params,
+                                            const Mat* inFrame = nullptr);
 //! Removes vertical runs of obj's grid of which ctx.observed shows no voxel.
 CV_EXPORTS int64 passUnobserved(ObjectClone& obj, const PassContext& ctx);
 
@@ -121,7 +125,8 @@ per object, its projection into each and the nearest depth of the other clones a
 `frames[f]` is the BGR image of frame f (validated by the caller). */
 CV_EXPORTS PhotoViews preparePhotoViews(const CloneSetImpl& clones, const Reconstruction& rec,
                                         const std::vector<Mat>& frames,
-                                        const CloneBuilder::PhotoParams& params);
+                                        const CloneBuilder::PhotoParams& params,
+                                        const Mat* inFrame = nullptr);
 //! One round of space carving by photo-consistency of obj (params.photo); updates the surface.
 CV_EXPORTS int64 passPhoto(ObjectClone& obj, const PassContext& ctx);
 

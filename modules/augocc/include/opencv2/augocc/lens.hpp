@@ -72,6 +72,11 @@ public:
     void toFrame(InputArray idealImage, OutputArray frameImage,
                  int interpolation = INTER_LINEAR, const Scalar& border = Scalar()) const;
 
+    //! Per frame pixel, the ideal pixel it sees (frameSize(), CV_32FC2; cv::remap's map).
+    const Mat& frameMap() const { return toFrameMap_; }
+    //! Per ideal pixel, the frame pixel it sees (idealSize(), CV_32FC2; cv::remap's map).
+    const Mat& idealMap() const { return toIdealMap_; }
+
     //! Internal: use get().
     LensView(const Camera& camera, Size frameSize);
 
