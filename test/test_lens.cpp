@@ -201,3 +201,61 @@ TEST(Augocc_Lens, reconstruction_file_round_trip)
 
 } // namespace
 } // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+
+// The slide figure: zero for the truth itself and for any similarity of it (gauge-free), large
+// at the image edges when the lens is ignored.
+TEST(Augocc_Lens, slide_measures_what_the_user_sees)
+{
+    Reconstruction truth;
+    truth.model = PERSPECTIVE;
+    truth.imageSize = kFrame;
+    RNG rng(5);
+    for (int f = 0; f < 12; f++)
+    {
+        const double a = (f - 6) * 2.0 * CV_PI / 180;
+        const Matx33d R = rotationFromRodrigues(Vec3d(0.02 * std::sin(f), a, 0.01 * f));
+        const Vec3d C(10 * std::sin(a) + 0.3 * f, 0.1 * f, -10 * std::cos(a));
+        truth.cameras.push_back(Camera::perspective(R, -(R * C),
+            Matx33d(1000, 0, 639.5, 0, 1000, 359.5, 0, 0, 1), f, {-0.12, 0.02, 0, 0, 0}));
+    }
+    truth.points = Mat(200, 3, CV_64F);
+    for (int p = 0; p < 200; p++)
+        for (int a = 0; a < 3; a++)
+            truth.points.at<double>(p, a) = rng.uniform(-3.0, 3.0);
+    const SlideStats self = measureSlide(truth, truth);
+    EXPECT_GT(self.points, 50);
+    EXPECT_LT(self.max, 1e-6);  // Gauss-Newton to convergence on exact pixels
+    // A similarity of the world (scale 2, a rotation, a shift): the same images, no slide.
+    Reconstruction moved = truth;
+    const Matx33d Q = rotationFromRodrigues(Vec3d(0.3, -0.2, 0.5));
+    const double sc = 2.0;
+    const Vec3d T(4, -1, 2);
+    for (Camera& c : moved.cameras)
+    {
+        // X' = sc Q X + T: R' = R Q^T, t' = sc t - R' T
+        const Matx33d R2 = c.R * Q.t();
+        c.t = sc * c.t - R2 * T;
+        c.R = R2;
+    }
+    for (int p = 0; p < moved.points.rows; p++)
+    {
+        const Vec3d X = sc * (Q * truth.point(p)) + T;
+        for (int a = 0; a < 3; a++)
+            moved.points.at<double>(p, a) = X[a];
+    }
+    EXPECT_LT(measureSlide(moved, truth).max, 1e-5);
+    // The lens ignored: the virtual points slide by pixels at the edges.
+    Reconstruction ignored = truth;
+    for (Camera& c : ignored.cameras)
+        c.distortion.clear();
+    const SlideStats bad = measureSlide(ignored, truth);
+    std::cout << "  lens ignored, true poses: slide median " << bad.median << " px, p95 "
+              << bad.p95 << ", max " << bad.max << std::endl;
+    EXPECT_GT(bad.max, 5.0);
+}
+
+} // namespace
+} // namespace opencv_test

@@ -185,5 +185,129 @@ Matx44d alignReconstructions(const Reconstruction& rec, const Reconstruction& re
                    A(2, 0), A(2, 1), A(2, 2), t[2], 0, 0, 0, 1);
 }
 
+
+SlideStats measureSlide(const Reconstruction& recovered, const Reconstruction& truth,
+                        int gridSteps, double margin)
+{
+    CV_Assert(gridSteps >= 2);
+    std::vector<double> axes[3];
+    for (int p = 0; p < recovered.points.rows; p++)
+        if (recovered.hasPoint(p))
+        {
+            const Vec3d X = recovered.point(p);
+            for (int a = 0; a < 3; a++)
+                axes[a].push_back(X[a]);
+        }
+    if (axes[0].empty())
+        CV_Error(Error::StsBadArg, "measureSlide: the recovered reconstruction has no point");
+    Vec3d lo, hi;
+    for (int a = 0; a < 3; a++)
+    {
+        std::sort(axes[a].begin(), axes[a].end());
+        const size_t n = axes[a].size();
+        lo[a] = axes[a][(size_t)(0.02 * (n - 1))];
+        hi[a] = axes[a][(size_t)(0.98 * (n - 1))];
+        const double ext = hi[a] - lo[a];
+        lo[a] -= margin * ext;
+        hi[a] += margin * ext;
+    }
+    std::vector<std::pair<const Camera*, const Camera*> > pairs;
+    for (const Camera& c : recovered.cameras)
+    {
+        const int t = truth.findCamera(c.frame);
+        if (t >= 0)
+            pairs.push_back(std::make_pair(&c, &truth.cameras[t]));
+    }
+    if (pairs.size() < 2)
+        CV_Error(Error::StsBadArg, "measureSlide: the reconstructions share fewer than two frames");
+    const Size size = truth.imageSize;
+    const int n = gridSteps;
+    std::vector<std::vector<double> > slides(n * n * n);
+    parallel_for_(Range(0, n * n * n), [&](const Range& r) {
+        for (int g = r.start; g < r.end; g++)
+        {
+            const Vec3d t((g % n) / (n - 1.0), ((g / n) % n) / (n - 1.0), (g / (n * n)) / (n - 1.0));
+            const Vec3d X(lo[0] + t[0] * (hi[0] - lo[0]), lo[1] + t[1] * (hi[1] - lo[1]),
+                          lo[2] + t[2] * (hi[2] - lo[2]));
+            std::vector<const Camera*> cams;
+            std::vector<Point2d> px;
+            for (const auto& pr : pairs)
+            {
+                if (pr.first->model == PERSPECTIVE && !(pr.first->depth(X) > 0))
+                    continue;
+                const Point2d u = pr.first->project(X);
+                if (u.x < -0.5 || u.y < -0.5 || u.x > size.width - 0.5 || u.y > size.height - 0.5)
+                    continue;
+                cams.push_back(pr.second);
+                px.push_back(u);
+            }
+            if (cams.size() < 2)
+                continue;
+            // Linear start: each pixel's ray through the true camera, the point nearest to all
+            // rays (least squares).
+            Matx33d A = Matx33d::zeros();
+            Vec3d b(0, 0, 0);
+            for (size_t i = 0; i < cams.size(); i++)
+            {
+                const Ray ray = cams[i]->backproject(px[i]);
+                const Matx33d P = Matx33d::eye() - ray.direction * ray.direction.t();
+                A += P;
+                b += P * ray.origin;
+            }
+            Vec3d Y;
+            if (!cv::solve(A, b, Y, DECOMP_SVD))
+                continue;
+            // Gauss-Newton on the pixel error, central-difference Jacobian.
+            for (int it = 0; it < 10; it++)
+            {
+                Matx33d H = Matx33d::zeros();
+                Vec3d gvec(0, 0, 0);
+                const double h = 1e-6 * std::max(1.0, cv::norm(Y));
+                for (size_t i = 0; i < cams.size(); i++)
+                {
+                    const Point2d e = cams[i]->project(Y) - px[i];
+                    Matx23d J;
+                    for (int a = 0; a < 3; a++)
+                    {
+                        Vec3d d(0, 0, 0);
+                        d[a] = h;
+                        const Point2d dp = (cams[i]->project(Y + d) - cams[i]->project(Y - d)) *
+                                           (0.5 / h);
+                        J(0, a) = dp.x;
+                        J(1, a) = dp.y;
+                    }
+                    H += J.t() * J;
+                    gvec += J.t() * Vec2d(e.x, e.y);
+                }
+                Vec3d step;
+                if (!cv::solve(H, -gvec, step, DECOMP_SVD))
+                    break;
+                Y += step;
+                if (cv::norm(step) < 1e-12 * std::max(1.0, cv::norm(Y)))
+                    break;
+            }
+            for (size_t i = 0; i < cams.size(); i++)
+                slides[g].push_back(cv::norm(cams[i]->project(Y) - px[i]));
+        }
+    });
+    SlideStats st;
+    std::vector<double> all;
+    for (const auto& s : slides)
+    {
+        if (s.empty())
+            continue;
+        st.points++;
+        all.insert(all.end(), s.begin(), s.end());
+    }
+    st.observations = (int)all.size();
+    if (all.empty())
+        return st;
+    std::sort(all.begin(), all.end());
+    st.median = all[all.size() / 2];
+    st.p95 = all[(size_t)(0.95 * (all.size() - 1))];
+    st.max = all.back();
+    return st;
+}
+
 } // namespace augocc
 } // namespace cv

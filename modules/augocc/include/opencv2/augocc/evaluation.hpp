@@ -57,6 +57,31 @@ translation by least squares on the camera translations. Used to compare a recon
 the synthetic ground truth. Throws StsBadArg without three common frames. */
 CV_EXPORTS Matx44d alignReconstructions(const Reconstruction& rec, const Reconstruction& reference);
 
+//! What measureSlide() found: pixels, over every (grid point, frame) pair counted.
+struct CV_EXPORTS SlideStats
+{
+    int points = 0;        //!< grid points seen in at least two frames
+    int observations = 0;  //!< (point, frame) pairs
+    double median = 0;     //!< median slide
+    double p95 = 0;        //!< 95th percentile
+    double max = 0;        //!< worst
+};
+
+/** @brief How far a virtual object placed with a recovered reconstruction slides against the
+real scene: the figure a user sees.
+
+For a grid of `gridSteps`^3 points spanning the box of the recovered points (their 2nd to 98th
+percentiles per axis, grown by `margin` of its size), each point is projected through the
+recovered cameras (with their lens); the real point that best explains those pixels through the
+true cameras (with their lens) is triangulated (linear start on undistorted rays, then
+Gauss-Newton on the pixel error); the slide is the pixel residual in every frame that sees the
+point inside the image. Invariant to the similarity ambiguity of the reconstruction: no
+alignment is needed. Frames need a camera in both reconstructions; `truth.imageSize` bounds
+the images.
+Throws StsBadArg when `recovered` has no valid point or the two share fewer than two frames. */
+CV_EXPORTS SlideStats measureSlide(const Reconstruction& recovered, const Reconstruction& truth,
+                                   int gridSteps = 6, double margin = 0.0);
+
 //! @}
 
 } // namespace augocc
