@@ -60,7 +60,7 @@ Matx33d lookAt(const Vec3d& C, const Vec3d& T, double roll)
 lower part of the image, as in street footage); the camera walks sideways at eye height (1.6 m plus a 10 cm
 sway), 1.5 scene sizes from the box centre, aimed at it with a wobble of about 2 degrees and a
 roll of up to 3 degrees (smooth: sums of slow sines). Each track is visible in one window of
-30-90 frames (partial tracks) and where it projects inside the image. */
+a third to all of the frames (partial tracks) and where it projects inside the image. */
 HandheldProblem makeHandheld(const HandheldParams& p)
 {
     RNG rng(p.seed);
@@ -101,7 +101,7 @@ HandheldProblem makeHandheld(const HandheldParams& p)
                             Scalar::all(std::numeric_limits<float>::quiet_NaN()));
     for (int i = 0; i < p.points; i++)
     {
-        const int len = rng.uniform(30, p.frames + 1);
+        const int len = rng.uniform(std::max(2, p.frames / 3), p.frames + 1);
         const int start = rng.uniform(0, p.frames - len + 1);
         for (int f = start; f < start + len; f++)
         {
