@@ -723,7 +723,8 @@ scaling about the first camera's centre moves most). `focalRelStd`, when not nul
 relative standard deviation of the focal (ceres::Covariance, residuals scaled to the RMS;
 -1 when it cannot be computed). Returns false (logged) when Ceres fails. */
 bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& freedom,
-                const OrthoCameraRefiner::Params& params, double* focalRelStd)
+                const OrthoCameraRefiner::Params& params, double* focalRelStd,
+                bool solve = true)
 {
     const int n = (int)rec.cameras.size(), P = tracks.points();
     CV_Assert(rec.model == PERSPECTIVE && n >= 2);
@@ -825,16 +826,28 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
     options.linear_solver_type = ceres::ITERATIVE_SCHUR;
     options.preconditioner_type = ceres::SCHUR_JACOBI;
-    options.linear_solver_ordering.reset(ordering);
-    options.max_num_iterations = std::max(params.maxIterations, 100);
-    options.function_tolerance = params.functionTolerance * 1e-2;
+    options.eta = detail::kBundleForcing;
+    options.max_num_iterations = params.maxIterations;
+    options.function_tolerance = params.functionTolerance;
     options.num_threads = cv::getNumThreads();
     options.minimizer_progress_to_stdout = false;
     options.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(options, &problem, &summary);
-    if (!solverUsable(summary, "lens bundle adjustment"))
-        return false;
+    double finalCost = 0;
+    if (solve)
+    {
+        options.linear_solver_ordering.reset(ordering);
+        ceres::Solver::Summary summary;
+        ceres::Solve(options, &problem, &summary);
+        if (!solverUsable(summary, "lens bundle adjustment"))
+            return false;
+        finalCost = summary.final_cost;
+    }
+    else
+    {
+        delete ordering;
+        problem.Evaluate(ceres::Problem::EvaluateOptions(), &finalCost, nullptr, nullptr,
+                         nullptr);
+    }
     if (focalRelStd)
     {
         *focalRelStd = -1;
@@ -848,10 +861,8 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
             cov.GetCovarianceBlock(intr, intr, C))
         {
             // Covariance of the unit-weight problem: scaled by the residual variance.
-            const double dof = std::max(1, summary.num_residuals_reduced -
-                                        summary.num_effective_parameters_reduced);
-            *focalRelStd = std::sqrt(std::max(0.0, C[0]) * 2 * summary.final_cost / dof) /
-                           intr[0];
+            const double dof = std::max(1, problem.NumResiduals() - problem.NumParameters());
+            *focalRelStd = std::sqrt(std::max(0.0, C[0]) * 2 * finalCost / dof) / intr[0];
         }
     }
     // The count of the input lens (a refined term is one it has: the callers give it the
@@ -1025,52 +1036,60 @@ void selfCalibrate(const Tracks& tracks, const SfmOptions& options, Reconstructi
                    SfmReport& rep)
 {
     rep.lensModel = "focal";
-    Reconstruction m1 = rec, m2;
-    m1.cameras[0].distortion.assign(4, 0.0);
+    // Nested models in order: focal + k1, then focal + k1 + k2 only when k1 beat the focal
+    // alone (the BIC of a coefficient that explains nothing already lost).
     LensFreedom free1;
     free1.focal = true;
     free1.coefficients = {0};
-    double relStd1 = -1;
-    if (!adjustLens(tracks, m1, free1, options.refiner, &relStd1))
-    {
-        rep.lensReason = "the lens bundle adjustment failed: the perspective solution is kept";
-        return;
-    }
-    m2 = m1;
     LensFreedom free2 = free1;
     free2.coefficients = {0, 1};
-    double relStd2 = -1;
-    if (!adjustLens(tracks, m2, free2, options.refiner, &relStd2))
+    std::vector<Reconstruction> models = {rec, rec};
+    models[1].cameras[0].distortion.assign(4, 0.0);
+    if (!adjustLens(tracks, models[1], free1, options.refiner, nullptr))
     {
         rep.lensReason = "the lens bundle adjustment failed: the perspective solution is kept";
         return;
     }
-    // BIC on one inlier set, that of the richest model.
     std::vector<uchar> inl;
     int N = 0;
-    const double rss2 = sumSquaredResiduals(tracks, m2, nullptr, options.lensInlierPx, &inl, &N);
-    const double rss1 = sumSquaredResiduals(tracks, m1, &inl, 0, nullptr, nullptr);
-    const double rss0 = sumSquaredResiduals(tracks, rec, &inl, 0, nullptr, nullptr);
-    const double rss[3] = {rss0, rss1, rss2};
     rep.lensBic.clear();
-    int bestModel = 0;
-    for (int k = 0; k < 3; k++)
+    auto bic = [&](const Reconstruction& m, int p) {
+        const double rss = sumSquaredResiduals(tracks, m, &inl, 0, nullptr, nullptr);
+        return N * std::log(std::max(rss, 1e-300) / N) + p * std::log(N);
+    };
+    // The inlier set: that of the richest model fitted so far, the same for every model.
+    auto scoreAll = [&]() {
+        sumSquaredResiduals(tracks, models.back(), nullptr, options.lensInlierPx, &inl, &N);
+        rep.lensBic.clear();
+        for (size_t k = 0; k < models.size(); k++)
+            rep.lensBic.push_back(bic(models[k], (int)k));
+    };
+    scoreAll();
+    if (rep.lensBic[1] < rep.lensBic[0])
     {
-        rep.lensBic.push_back(N * std::log(std::max(rss[k], 1e-300) / N) + k * std::log(N));
-        if (rep.lensBic[k] < rep.lensBic[bestModel])
-            bestModel = k;
+        models.push_back(models[1]);
+        if (adjustLens(tracks, models[2], free2, options.refiner, nullptr))
+            scoreAll();
+        else
+            models.pop_back();
     }
-    const String bic = cv::format("BIC focal %.1f, focal_k1 %.1f, focal_k1_k2 %.1f over %d "
-                                  "residuals", rep.lensBic[0], rep.lensBic[1], rep.lensBic[2], N);
+    const int bestModel = (int)(std::min_element(rep.lensBic.begin(), rep.lensBic.end()) -
+                                rep.lensBic.begin());
+    const char* names[3] = {"focal", "focal_k1", "focal_k1_k2"};
+    String bicText = "BIC";
+    for (size_t k = 0; k < rep.lensBic.size(); k++)
+        bicText += cv::format(" %s %.1f", names[k], rep.lensBic[k]);
+    bicText += cv::format(" over %d residuals", N);
     if (bestModel == 0)
     {
-        rep.lensReason = "no evidence of lens distortion (" + bic + "): the perspective "
+        rep.lensReason = "no evidence of lens distortion (" + bicText + "): the perspective "
                          "solution is kept";
         return;
     }
-    Reconstruction& best = bestModel == 1 ? m1 : m2;
-    // The covariance of the kept model (k2 correlates with the focal).
-    const double relStd = bestModel == 1 ? relStd1 : relStd2;
+    // The focal's standard deviation in the kept model (k2 correlates with the focal).
+    double relStd = -1;
+    Reconstruction best = models[bestModel];
+    adjustLens(tracks, best, bestModel == 1 ? free1 : free2, options.refiner, &relStd, false);
     rep.focalRelStd = relStd;
     if (!(relStd >= 0) || relStd > options.maxFocalRelStd)
     {
@@ -1078,13 +1097,13 @@ void selfCalibrate(const Tracks& tracks, const SfmOptions& options, Reconstructi
                                     "deviation %.3g > %.3g: too little depth variation or "
                                     "rotation to tell it from the distance): the perspective "
                                     "solution is kept, no distortion; ", relStd,
-                                    options.maxFocalRelStd) + bic;
+                                    options.maxFocalRelStd) + bicText;
         return;
     }
-    rec = best;
-    rep.lensModel = bestModel == 1 ? "focal_k1" : "focal_k1_k2";
+    rec = models[bestModel];
+    rep.lensModel = names[bestModel];
     rep.lensReason = cv::format("self-calibrated, focal relative standard deviation %.2g; ",
-                                relStd) + bic;
+                                relStd) + bicText;
 }
 
 } // namespace

@@ -153,7 +153,8 @@ struct CV_EXPORTS SfmOptions
     radial k1, k2 (COLMAP's RADIAL). The lens kept is the one of {focal only, focal + k1,
     focal + k1 + k2} with the lowest BIC, N log(RSS / N) + p log N over the N residual
     coordinates of the observations within `lensInlierPx` of the richest model's reprojection
-    (the same set for all three; p counts the lens parameters beyond the focal), so that a
+    (the same set for all; p counts the lens parameters beyond the focal; focal + k1 + k2 is fitted
+only when focal + k1 beat the focal alone), so that a
     coefficient is kept only when it explains more than noise does (a chance drop of the RSS by
     one parameter is chi-square(1) sigma^2, the penalty log N sigma^2). "focal only" keeps the
     perspective solution unchanged. The kept lens is dropped again (the prior, the perspective
@@ -191,7 +192,8 @@ struct CV_EXPORTS SfmReport
     String lensReason;
     //! relative standard deviation of the self-calibrated focal (0: not computed)
     double focalRelStd = 0;
-    //! BIC of {focal, focal_k1, focal_k1_k2} (self-calibration only; empty otherwise)
+    //! BIC of the models tried, in the order focal, focal_k1, focal_k1_k2 (self-calibration
+    //! only; empty otherwise)
     std::vector<double> lensBic;
     //! after the lens bundle adjustment (if run), against the original observations
     ReprojectionStats lens;
