@@ -4,6 +4,7 @@
 
 #include <cctype>
 #include <climits>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -48,6 +49,38 @@ void requireFile(const std::string& flag, const std::string& path)
 {
     if (!std::filesystem::exists(path))
         throw UsageError(flag + " " + path + ": no such file or folder");
+}
+
+void checkIntrinsicsFlags(const std::string& calibration, double focal, bool refine)
+{
+    if (!calibration.empty())
+        requireFile("--calibration", calibration);
+    if (!calibration.empty() && focal != 0)
+        throw UsageError("--focal: give --calibration or --focal, not both");
+    if (focal != 0 && !(focal > 0 && std::isfinite(focal)))
+        throw UsageError(cv::format("--focal %g: must be a positive number of pixels", focal));
+    if (refine && calibration.empty() && focal == 0)
+        throw UsageError("--refine-intrinsics: needs --calibration or --focal");
+}
+
+void setIntrinsicsOptions(const std::string& calibration, double focal, bool refine,
+                          cv::Size frameSize, cv::augocc::SfmOptions& options)
+{
+    checkIntrinsicsFlags(calibration, focal, refine);
+    if (!calibration.empty())
+        options.calibration = cv::augocc::readCalibration(calibration, frameSize);
+    options.focal = focal;
+    options.refineIntrinsics = refine;
+}
+
+std::string lensLine(const cv::augocc::SfmReport& r)
+{
+    std::string k;
+    for (size_t i = 0; i < r.distortion.size(); i++)
+        k += cv::format("%s%.5g", i ? ", " : "", r.distortion[i]);
+    return "  lens: " + r.lensModel + (r.focal > 0 ? cv::format(", focal %.2f px", r.focal)
+                                                     : std::string()) +
+           (k.empty() ? std::string() : ", distortion [" + k + "]") + ": " + r.lensReason;
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include <vector>
 #include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
+#include "opencv2/augocc/camera_refiner.hpp"
 
 namespace augocc_cli {
 
@@ -46,6 +47,19 @@ void info(const Globals& g, const std::string& line);
 
 //! Throws UsageError naming the flag when the file does not exist.
 void requireFile(const std::string& flag, const std::string& path);
+
+//! Throws UsageError naming the flag when the known-intrinsics flags do not go together.
+void checkIntrinsicsFlags(const std::string& calibration, double focal, bool refine);
+
+/** @brief The known-intrinsics flags of `sfm` and `run` into SfmOptions: `--calibration FILE`
+(read for frames of `frameSize`; a bad file throws cv::Exception naming it and the key, exit
+status 2), `--focal PX` (positive), `--refine-intrinsics` (needs one of them). Throws UsageError
+naming the flag on misuse. */
+void setIntrinsicsOptions(const std::string& calibration, double focal, bool refine,
+                          cv::Size frameSize, cv::augocc::SfmOptions& options);
+
+//! The lens line of the sfm log: model, focal, coefficients and the reason.
+std::string lensLine(const cv::augocc::SfmReport& report);
 
 //! One item of a frame list: frames first, first + step, ... before end.
 struct FrameRange

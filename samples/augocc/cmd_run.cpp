@@ -35,6 +35,9 @@ struct RunCliOptions
     bool hardEdges = false;
     bool antialiasVirtual = false;
     bool noPhotoRefine = false;
+    std::string calibration;
+    double focal = 0;
+    bool refineIntrinsics = false;
 };
 
 void runRun(const Globals& g, const RunCliOptions& o)
@@ -50,6 +53,10 @@ void runRun(const Globals& g, const RunCliOptions& o)
     ro.supersample = o.hardEdges ? 1 : Compositor::Params().supersample;
     ro.antialiasVirtual = o.antialiasVirtual;
     ro.photoRefine = !o.noPhotoRefine;
+    checkIntrinsicsFlags(o.calibration, o.focal, o.refineIntrinsics);
+    ro.calibrationPath = o.calibration;
+    ro.focal = o.focal;
+    ro.refineIntrinsics = o.refineIntrinsics;
     std::shared_ptr<Progress> current;
     auto stage = std::make_shared<std::string>();
     ro.progress = stageProgress(g, current, stage);
@@ -58,6 +65,7 @@ void runRun(const Globals& g, const RunCliOptions& o)
         current->finish();
     for (const auto& s : r.stageSeconds)
         info(g, cv::format("%-10s %7.2f s", s.first.c_str(), s.second));
+    info(g, lensLine(r.sfm));
     info(g, "outputs in " + o.outDir + (r.compositePath.empty()
                                             ? " (no --scene: stopped after the mattes)"
                                             : ", composite: " + r.compositePath));
@@ -80,6 +88,11 @@ void registerRun(CLI::App& app, Globals& g)
                   "objects' own outlines (renders them at 3x: slower)")->excludes("--hard-edges");
     sub->add_flag("--no-photo-refine", o->noPhotoRefine, "clones from the silhouettes alone (no "
                   "photo-consistency carving over the frames)");
+    sub->add_option("--calibration", o->calibration, "known intrinsics: OpenCV's calibration "
+                    "file (as augocc sfm --calibration)");
+    sub->add_option("--focal", o->focal, "known focal length only, pixels")
+        ->excludes("--calibration");
+    sub->add_flag("--refine-intrinsics", o->refineIntrinsics, "refine the given intrinsics");
     sub->callback([&g, o]() { runRun(g, *o); });
 }
 

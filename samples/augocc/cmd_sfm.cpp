@@ -11,8 +11,9 @@ namespace {
 
 struct SfmArgs
 {
-    std::string tracks, out, model = "auto", colmap, ply;
-    bool noBundle = false;
+    std::string tracks, out, model = "auto", colmap, ply, calibration;
+    double focal = 0;
+    bool noBundle = false, refineIntrinsics = false;
 };
 
 std::string statsLine(const cv::augocc::ReprojectionStats& s)
@@ -35,6 +36,13 @@ void registerSfm(CLI::App& app, Globals& g)
                     "more than 10%)");
     sub->add_option("--colmap", args->colmap, "also write a COLMAP text model into this folder");
     sub->add_option("--ply", args->ply, "also write the 3D points as a PLY file");
+    sub->add_option("--calibration", args->calibration, "known intrinsics: OpenCV's "
+                    "calibration file (camera_matrix, distortion_coefficients, optional "
+                    "image_width / image_height; scaled to the frames when of the same aspect)");
+    sub->add_option("--focal", args->focal, "known focal length only, pixels (principal point "
+                    "at the image centre, no distortion)")->excludes("--calibration");
+    sub->add_flag("--refine-intrinsics", args->refineIntrinsics, "refine the given focal length "
+                  "and distortion (default: they stay fixed)");
     sub->add_flag("--no-ba", args->noBundle, "skip the full bundle adjustment (the paper's "
                   "3F+1 refinement only)");
     sub->callback([args, &g]() {
@@ -47,6 +55,8 @@ void registerSfm(CLI::App& app, Globals& g)
         cv::augocc::SfmOptions opt;
         opt.model = args->model;
         opt.bundleAdjust = !args->noBundle;
+        setIntrinsicsOptions(args->calibration, args->focal, args->refineIntrinsics,
+                             tracks.imageSize, opt);
         cv::augocc::SfmReport rep;
         Progress progress(g, "sfm", 1);
         const cv::augocc::Reconstruction rec = cv::augocc::recoverCameras(tracks, opt, &rep);
@@ -66,6 +76,9 @@ void registerSfm(CLI::App& app, Globals& g)
             info(g, "  orthographic BA:     " + statsLine(rep.orthographic));
         if (rep.perspective.observations > 0)
             info(g, "  perspective BA:      " + statsLine(rep.perspective));
+        if (rep.lens.observations > 0)
+            info(g, "  lens BA:             " + statsLine(rep.lens));
+        info(g, lensLine(rep));
         info(g, "wrote " + args->out);
     });
 }

@@ -605,7 +605,23 @@ int rescueTracks(const Tracks& tracks, Reconstruction& rec)
             if ((int)cams.size() < kRescueMinViews)
                 continue;
             Vec3d Y;
-            if (!detail::triangulatePoint(cams, obs, Y))
+            // Triangulated through the pinholes on the undistorted observations (the
+            // triangulation's equations are those of the pinhole); judged with the lens below.
+            std::vector<Camera> pinholes;
+            std::vector<const Camera*> pinholePtrs;
+            std::vector<Point2d> ideal;
+            if (!cams.empty() && cams.front()->hasDistortion())
+            {
+                for (size_t k = 0; k < cams.size(); k++)
+                {
+                    pinholes.push_back(cams[k]->pinhole());
+                    ideal.push_back(cams[k]->undistortPixel(obs[k]));
+                }
+                for (const Camera& c : pinholes)
+                    pinholePtrs.push_back(&c);
+            }
+            if (!(pinholes.empty() ? detail::triangulatePoint(cams, obs, Y)
+                                   : detail::triangulatePoint(pinholePtrs, ideal, Y)))
                 continue;
             double s2 = 0, worst = 0;
             bool front = true;
@@ -633,13 +649,325 @@ int rescueTracks(const Tracks& tracks, Reconstruction& rec)
 
 } // namespace
 
-Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, SfmReport* report)
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Lens bundle adjustment: the pinhole with OpenCV's distortion on the frames' own pixels.
+
+//! What the lens bundle adjustment refines besides poses and points.
+struct LensFreedom
+{
+    bool focal = false;             //!< the focal length (fx; fy / fx kept)
+    std::vector<int> coefficients;  //!< indices (0..11) into the 12 distortion terms refined
+};
+
+// The tilt homography (coefficients tx, ty of a 14-coefficient lens) as a 3x3 matrix, from the
+// camera model itself: the distortion with only tx, ty set is that homography of the
+// normalised point, so four points determine it exactly.
+Matx33d tiltHomography(const std::vector<double>& d)
+{
+    if (d.size() < 14 || (d[12] == 0 && d[13] == 0))
+        return Matx33d::eye();
+    Camera c = Camera::perspective(Matx33d::eye(), Vec3d(0, 0, 0), Matx33d::eye());
+    c.distortion.assign(14, 0.0);
+    c.distortion[12] = d[12];
+    c.distortion[13] = d[13];
+    std::vector<Point2f> a = {Point2f(-0.5f, -0.5f), Point2f(0.5f, -0.5f), Point2f(0.5f, 0.5f),
+                              Point2f(-0.5f, 0.5f)}, b;
+    for (const Point2f& p : a)
+        b.push_back(Point2f(c.distortNormalized(Point2d(p))));
+    Matx33d H = getPerspectiveTransform(a, b);
+    return H * (1.0 / H(2, 2));
+}
+
+// The pixel (u, v) of every observation of a reconstructed point in every reconstructed frame,
+// with its residual under `rec`.
+double sumSquaredResiduals(const Tracks& tracks, const Reconstruction& rec,
+                           const std::vector<uchar>* inlier, double inlierPx,
+                           std::vector<uchar>* inlierOut, int* count)
+{
+    double rss = 0;
+    int n = 0;
+    size_t k = 0;
+    if (inlierOut)
+        inlierOut->clear();
+    for (const Camera& cam : rec.cameras)
+    {
+        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
+        for (int p = 0; p < tracks.points(); p++)
+        {
+            if (!std::isfinite(row[p].x) || !rec.hasPoint(p))
+                continue;
+            const Point2d e = cam.project(rec.point(p)) - Point2d(row[p].x, row[p].y);
+            const double e2 = e.dot(e);
+            const bool in = inlier ? (*inlier)[k] != 0 : e2 <= inlierPx * inlierPx;
+            if (inlierOut)
+                inlierOut->push_back(in);
+            k++;
+            if (!in)
+                continue;
+            rss += e2;
+            n += 2;
+        }
+    }
+    if (count)
+        *count = n;
+    return rss;
+}
+
+/** Bundle adjustment of the perspective cameras of `rec` (one K and one distortion for all of
+them: the first camera's) on the observations of `tracks`, pixels of the frames. Poses
+(quaternion manifold) and points always; the focal and distortion terms of `freedom`. Gauge: the
+first camera's pose, and the scale by one coordinate of the camera farthest from it (the one that
+scaling about the first camera's centre moves most). `focalRelStd`, when not null, gets the
+relative standard deviation of the focal (ceres::Covariance, residuals scaled to the RMS;
+-1 when it cannot be computed). Returns false (logged) when Ceres fails. */
+bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& freedom,
+                const OrthoCameraRefiner::Params& params, double* focalRelStd,
+                bool solve = true)
+{
+    const int n = (int)rec.cameras.size(), P = tracks.points();
+    CV_Assert(rec.model == PERSPECTIVE && n >= 2);
+    const Camera& c0 = rec.cameras[0];
+    double intr[3] = {c0.K(0, 0), c0.K(0, 2), c0.K(1, 2)};
+    const double aspect = c0.K(1, 1) / c0.K(0, 0), skew = c0.K(0, 1) / c0.K(0, 0);
+    double dist[12] = {0};
+    for (size_t k = 0; k < std::min<size_t>(12, c0.distortion.size()); k++)
+        dist[k] = c0.distortion[k];
+    const Matx33d tilt = tiltHomography(c0.distortion);
+    std::vector<Eigen::Quaterniond> q(n);
+    std::vector<Vec3d> t(n);
+    for (int i = 0; i < n; i++)
+    {
+        q[i] = detail::toQuaternion(rec.cameras[i].R);
+        t[i] = rec.cameras[i].t;
+    }
+    Mat X = rec.points.clone();
+    ceres::Problem::Options po;
+    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(po);
+    ceres::EigenQuaternionManifold quatManifold;
+    std::unique_ptr<ceres::LossFunction> loss;
+    if (params.loss == OrthoCameraRefiner::LOSS_HUBER)
+        loss.reset(new ceres::HuberLoss(params.lossScale));
+    else if (params.loss == OrthoCameraRefiner::LOSS_CAUCHY)
+        loss.reset(new ceres::CauchyLoss(params.lossScale));
+    ceres::ParameterBlockOrdering* ordering = new ceres::ParameterBlockOrdering;
+    std::vector<uchar> used;
+    forEachObservationPointMajor(tracks, rec, used,
+                                 [&](int i, int p, const Point2f& o, const Point2d&) {
+        problem.AddResidualBlock(detail::LensReprojectionError::Create(o.x, o.y, aspect, skew,
+                                 tilt), loss.get(), q[i].coeffs().data(), t[i].val,
+                                 X.ptr<double>(p), intr, dist);
+    });
+    if (problem.NumResidualBlocks() == 0)
+        CV_Error(Error::StsBadArg, "reconstruction: no observation of a reconstructed point");
+    int farthest = -1;
+    double best = 0;
+    const Vec3d center0 = c0.center();
+    for (int i = 0; i < n; i++)
+    {
+        if (!problem.HasParameterBlock(q[i].coeffs().data()))
+            continue;
+        problem.SetManifold(q[i].coeffs().data(), &quatManifold);
+        ordering->AddElementToGroup(q[i].coeffs().data(), 1);
+        ordering->AddElementToGroup(t[i].val, 1);
+        const double d = cv::norm(rec.cameras[i].center() - center0);
+        if (i > 0 && d > best)
+        {
+            best = d;
+            farthest = i;
+        }
+    }
+    for (int p = 0; p < P; p++)
+        if (used[p])
+            ordering->AddElementToGroup(X.ptr<double>(p), 0);
+    ordering->AddElementToGroup(intr, 1);
+    ordering->AddElementToGroup(dist, 1);
+    // Gauge: the first camera's pose; the scale by the coordinate of the farthest camera's
+    // translation that a scaling about the first camera's centre changes most,
+    // d t_k / d lambda = -R_k (c_k - c_0). Without camera motion, no scale to fix.
+    problem.SetParameterBlockConstant(q[0].coeffs().data());
+    problem.SetParameterBlockConstant(t[0].val);
+    std::unique_ptr<ceres::SubsetManifold> scaleGauge, intrManifold, distManifold;
+    if (farthest > 0)
+    {
+        const Camera& ck = rec.cameras[farthest];
+        const Vec3d g = ck.R * (ck.center() - center0);
+        int j = 0;
+        for (int k = 1; k < 3; k++)
+            if (std::abs(g[k]) > std::abs(g[j]))
+                j = k;
+        scaleGauge.reset(new ceres::SubsetManifold(3, {j}));
+        problem.SetManifold(t[farthest].val, scaleGauge.get());
+    }
+    if (freedom.focal)
+    {
+        intrManifold.reset(new ceres::SubsetManifold(3, {1, 2}));   // principal point held
+        problem.SetManifold(intr, intrManifold.get());
+    }
+    else
+        problem.SetParameterBlockConstant(intr);
+    if (freedom.coefficients.empty())
+        problem.SetParameterBlockConstant(dist);
+    else
+    {
+        std::vector<int> held;
+        for (int k = 0; k < 12; k++)
+            if (std::find(freedom.coefficients.begin(), freedom.coefficients.end(), k) ==
+                freedom.coefficients.end())
+                held.push_back(k);
+        distManifold.reset(new ceres::SubsetManifold(12, held));
+        problem.SetManifold(dist, distManifold.get());
+    }
+    ceres::Solver::Options options;
+    options.minimizer_type = ceres::TRUST_REGION;
+    options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    options.linear_solver_type = ceres::ITERATIVE_SCHUR;
+    options.preconditioner_type = ceres::SCHUR_JACOBI;
+    options.eta = detail::kBundleForcing;
+    options.max_num_iterations = params.maxIterations;
+    options.function_tolerance = params.functionTolerance;
+    options.num_threads = cv::getNumThreads();
+    options.minimizer_progress_to_stdout = false;
+    options.logging_type = ceres::SILENT;
+    double finalCost = 0;
+    if (solve)
+    {
+        options.linear_solver_ordering.reset(ordering);
+        ceres::Solver::Summary summary;
+        ceres::Solve(options, &problem, &summary);
+        if (!solverUsable(summary, "lens bundle adjustment"))
+            return false;
+        finalCost = summary.final_cost;
+    }
+    else
+    {
+        delete ordering;
+        problem.Evaluate(ceres::Problem::EvaluateOptions(), &finalCost, nullptr, nullptr,
+                         nullptr);
+    }
+    if (focalRelStd)
+    {
+        *focalRelStd = -1;
+        ceres::Covariance::Options co;
+        co.algorithm_type = ceres::SPARSE_QR;
+        co.num_threads = cv::getNumThreads();
+        ceres::Covariance cov(co);
+        std::vector<std::pair<const double*, const double*>> blocks = {{intr, intr}};
+        double C[9];
+        if (freedom.focal && cov.Compute(blocks, &problem) &&
+            cov.GetCovarianceBlock(intr, intr, C))
+        {
+            // Covariance of the unit-weight problem: scaled by the residual variance.
+            const double dof = std::max(1, problem.NumResiduals() - problem.NumParameters());
+            *focalRelStd = std::sqrt(std::max(0.0, C[0]) * 2 * finalCost / dof) / intr[0];
+        }
+    }
+    // The count of the input lens (a refined term is one it has: the callers give it the
+    // count they refine); the tilt terms are never refined.
+    std::vector<double> d = c0.distortion;
+    for (size_t k = 0; k < std::min<size_t>(12, d.size()); k++)
+        d[k] = dist[k];
+    const Matx33d K(intr[0], skew * intr[0], intr[1], 0, aspect * intr[0], intr[2], 0, 0, 1);
+    for (int i = 0; i < n; i++)
+    {
+        Camera& cam = rec.cameras[i];
+        cam = Camera::perspective(detail::fromQuaternion(q[i].coeffs().data()), t[i], K,
+                                  cam.frame, d);
+    }
+    for (int p = 0; p < P; p++)
+        if (!used[p])
+            X.row(p).setTo(std::numeric_limits<double>::quiet_NaN());
+    rec.points = X;
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Known intrinsics
+
+// The lens the options give (calibration, or a focal with the principal point at the image
+// centre), or an empty optional (model SCALED_ORTHOGRAPHIC) when none.
+bool knownLens(const SfmOptions& o, Size imageSize, Camera& lens)
+{
+    const bool hasCal = !o.calibration.imageSize.empty();
+    if (hasCal && o.focal > 0)
+        CV_Error(Error::StsBadArg, "sfm: give the calibration or the focal length, not both");
+    if (o.focal != 0 && !(o.focal > 0 && std::isfinite(o.focal)))
+        CV_Error(Error::StsBadArg, cv::format("sfm: --focal %g must be a positive number of "
+                 "pixels", o.focal));
+    if (hasCal)
+    {
+        if (o.calibration.imageSize != imageSize)
+            CV_Error(Error::StsBadSize, cv::format("sfm: the calibration is for %d x %d, the "
+                     "tracks' frames are %d x %d (readCalibration scales it)",
+                     o.calibration.imageSize.width, o.calibration.imageSize.height,
+                     imageSize.width, imageSize.height));
+        lens = o.calibration.camera();
+        lens.validate("calibration");
+        return true;
+    }
+    if (o.focal > 0)
+    {
+        lens = Camera::perspective(Matx33d::eye(), Vec3d(0, 0, 0), Matx33d(o.focal, 0,
+                                   (imageSize.width - 1) * 0.5, 0, o.focal,
+                                   (imageSize.height - 1) * 0.5, 0, 0, 1));
+        return true;
+    }
+    return false;
+}
+
+// The tracks as an ideal square-pixel pinhole with focal fx and the principal point at the
+// image centre would see them (what the affine and perspective stages assume).
+Tracks idealTracks(const Tracks& tracks, const Camera& lens)
+{
+    Tracks ideal = tracks;
+    ideal.tracks = tracks.tracks.clone();
+    const Point2d c((tracks.imageSize.width - 1) * 0.5, (tracks.imageSize.height - 1) * 0.5);
+    const Matx33d& K = lens.K;
+    parallel_for_(Range(0, ideal.frames()), [&](const Range& r) {
+        for (int f = r.start; f < r.end; f++)
+        {
+            Point2f* row = ideal.tracks.ptr<Point2f>(f);
+            for (int p = 0; p < ideal.points(); p++)
+            {
+                if (!std::isfinite(row[p].x))
+                    continue;
+                const Point2d u = lens.undistortPixel(Point2d(row[p].x, row[p].y));
+                const double y = (u.y - K(1, 2)) / K(1, 1);
+                const double x = (u.x - K(0, 2) - K(0, 1) * y) / K(0, 0);
+                row[p] = Point2f((float)(K(0, 0) * x + c.x), (float)(K(0, 0) * y + c.y));
+            }
+        }
+    });
+    return ideal;
+}
+
+// The perspective solution of the ideal tracks brought to the known lens: each camera is
+// dollied along its axis so that the scene's centroid keeps its image size at the known focal
+// (f / z constant), the start of the lens bundle adjustment.
+void applyKnownLens(Reconstruction& rec, const Camera& lens)
+{
+    Vec3d c;
+    detail::rmsRadius(rec.points, &c);
+    for (Camera& cam : rec.cameras)
+    {
+        const double ratio = lens.K(0, 0) / cam.K(0, 0);
+        const double z = cam.depth(c);
+        cam = Camera::perspective(cam.R, cam.t + Vec3d(0, 0, (ratio - 1) * z), lens.K,
+                                  cam.frame, lens.distortion);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Stages of recoverCameras
+
+// Factorization, the paper's 3F+1, the scaled-orthographic BA, the depth-reversal prior and the
+// perspective BA with the model choice: the affine and perspective stages.
+Reconstruction recoverPinhole(const Tracks& tracks, const SfmOptions& options, SfmReport& rep)
 {
     const String model = options.model;
-    if (model != "auto" && model != "scaled_orthographic" && model != "perspective")
-        CV_Error(Error::StsBadArg, "--model " + model + ": expected scaled_orthographic, "
-                 "perspective or auto");
-    SfmReport rep;
     Reconstruction rec;
     Mat inliers;
     if (!FactorizationSfM::create(options.factorization)->reconstruct(tracks, rec, inliers))
@@ -698,6 +1026,149 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
                 rep.chosenModel = "perspective";
             }
         }
+    }
+    return rec;
+}
+
+// Self-calibration of the lens after the perspective solution (see SfmOptions::selfCalibrate):
+// focal, focal + k1, focal + k1 + k2 by BIC; the prior kept when the focal is not determined.
+void selfCalibrate(const Tracks& tracks, const SfmOptions& options, Reconstruction& rec,
+                   SfmReport& rep)
+{
+    rep.lensModel = "focal";
+    // Nested models in order: focal + k1, then focal + k1 + k2 only when k1 beat the focal
+    // alone (the BIC of a coefficient that explains nothing already lost).
+    LensFreedom free1;
+    free1.focal = true;
+    free1.coefficients = {0};
+    LensFreedom free2 = free1;
+    free2.coefficients = {0, 1};
+    std::vector<Reconstruction> models = {rec, rec};
+    models[1].cameras[0].distortion.assign(4, 0.0);
+    if (!adjustLens(tracks, models[1], free1, options.refiner, nullptr))
+    {
+        rep.lensReason = "the lens bundle adjustment failed: the perspective solution is kept";
+        return;
+    }
+    std::vector<uchar> inl;
+    int N = 0;
+    rep.lensBic.clear();
+    auto bic = [&](const Reconstruction& m, int p) {
+        const double rss = sumSquaredResiduals(tracks, m, &inl, 0, nullptr, nullptr);
+        return N * std::log(std::max(rss, 1e-300) / N) + p * std::log(N);
+    };
+    // The inlier set: that of the richest model fitted so far, the same for every model.
+    auto scoreAll = [&]() {
+        sumSquaredResiduals(tracks, models.back(), nullptr, options.lensInlierPx, &inl, &N);
+        rep.lensBic.clear();
+        for (size_t k = 0; k < models.size(); k++)
+            rep.lensBic.push_back(bic(models[k], (int)k));
+    };
+    scoreAll();
+    if (rep.lensBic[1] < rep.lensBic[0])
+    {
+        models.push_back(models[1]);
+        if (adjustLens(tracks, models[2], free2, options.refiner, nullptr))
+            scoreAll();
+        else
+            models.pop_back();
+    }
+    const int bestModel = (int)(std::min_element(rep.lensBic.begin(), rep.lensBic.end()) -
+                                rep.lensBic.begin());
+    const char* names[3] = {"focal", "focal_k1", "focal_k1_k2"};
+    String bicText = "BIC";
+    for (size_t k = 0; k < rep.lensBic.size(); k++)
+        bicText += cv::format(" %s %.1f", names[k], rep.lensBic[k]);
+    bicText += cv::format(" over %d residuals", N);
+    if (bestModel == 0)
+    {
+        rep.lensReason = "no evidence of lens distortion (" + bicText + "): the perspective "
+                         "solution is kept";
+        return;
+    }
+    // The focal's standard deviation in the kept model (k2 correlates with the focal).
+    double relStd = -1;
+    Reconstruction best = models[bestModel];
+    adjustLens(tracks, best, bestModel == 1 ? free1 : free2, options.refiner, &relStd, false);
+    rep.focalRelStd = relStd;
+    if (!(relStd >= 0) || relStd > options.maxFocalRelStd)
+    {
+        rep.lensReason = cv::format("the focal length is not determined (relative standard "
+                                    "deviation %.3g > %.3g: too little depth variation or "
+                                    "rotation to tell it from the distance): the perspective "
+                                    "solution is kept, no distortion; ", relStd,
+                                    options.maxFocalRelStd) + bicText;
+        return;
+    }
+    rec = models[bestModel];
+    rep.lensModel = names[bestModel];
+    rep.lensReason = cv::format("self-calibrated, focal relative standard deviation %.2g; ",
+                                relStd) + bicText;
+}
+
+} // namespace
+
+Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, SfmReport* report)
+{
+    const String model = options.model;
+    if (model != "auto" && model != "scaled_orthographic" && model != "perspective")
+        CV_Error(Error::StsBadArg, "--model " + model + ": expected scaled_orthographic, "
+                 "perspective or auto");
+    if (!(options.lensInlierPx > 0) || !(options.maxFocalRelStd > 0))
+        CV_Error(Error::StsBadArg, "sfm: lensInlierPx and maxFocalRelStd must be positive");
+    tracks.validate("tracks");
+    SfmReport rep;
+    Reconstruction rec;
+    Camera lens;
+    if (knownLens(options, tracks.imageSize, lens))
+    {
+        // Known intrinsics: the affine and perspective stages on the undistorted observations,
+        // then the lens bundle adjustment on the frames' own pixels.
+        if (model == "scaled_orthographic")
+            CV_Error(Error::StsBadArg, "sfm: known intrinsics need the perspective model, not "
+                     "scaled_orthographic");
+        SfmOptions pinhole = options;
+        pinhole.model = "perspective";
+        rec = recoverPinhole(idealTracks(tracks, lens), pinhole, rep);
+        applyKnownLens(rec, lens);
+        LensFreedom freedom;
+        freedom.focal = options.refineIntrinsics;
+        if (options.refineIntrinsics)
+            for (int k = 0; k < std::min<int>(12, (int)lens.distortion.size()); k++)
+                freedom.coefficients.push_back(k);
+        if (!adjustLens(tracks, rec, freedom, options.refiner, nullptr))
+            CV_Error(Error::StsError, "sfm: the lens bundle adjustment failed (see the log)");
+        rep.lens = computeReprojectionStats(rec, tracks);
+        rep.lensModel = options.refineIntrinsics ? "given_refined" : "given";
+        rep.lensReason = options.refineIntrinsics ? "known intrinsics, focal and distortion "
+                         "refined" : "known intrinsics, held fixed";
+    }
+    else
+    {
+        rec = recoverPinhole(tracks, options, rep);
+        if (rec.model != PERSPECTIVE)
+        {
+            rep.lensModel = "none";
+            rep.lensReason = "scaled orthographic model chosen (no measurable perspective): no "
+                             "focal length or lens distortion to estimate";
+        }
+        else if (!options.selfCalibrate)
+        {
+            rep.lensModel = "focal";
+            rep.lensReason = "self-calibration off: the perspective solution's focal";
+        }
+        else
+        {
+            selfCalibrate(tracks, options, rec, rep);
+            if (rep.lensModel != "focal")
+                rep.lens = computeReprojectionStats(rec, tracks);
+        }
+    }
+    CV_LOG_INFO(NULL, "augocc sfm: lens " + rep.lensModel + ": " + rep.lensReason);
+    if (rec.model == PERSPECTIVE)
+    {
+        rep.focal = rec.cameras.front().K(0, 0);
+        rep.distortion = rec.cameras.front().distortion;
     }
     rep.rescuedTracks = rescueTracks(tracks, rec);
     rep.inlierTracks += rep.rescuedTracks;

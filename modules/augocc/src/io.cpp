@@ -379,6 +379,78 @@ void writeReconstruction(const String& path, const Reconstruction& rec)
 // ---------------------------------------------------------------------------------------------
 // Masks
 
+// ---------------------------------------------------------------------------------------------
+// Calibration (OpenCV's calibrateCamera file)
+
+Calibration readCalibration(const String& path, Size frameSize)
+{
+    FileStorage storage = detail::openFileStorageForRead(path, "calibration file");
+    FileNode root = storage.root();
+    Calibration cal;
+    cal.K = readFixedMat<Matx33d>(root, "camera_matrix", path);
+    for (int k = 0; k < 9; k++)
+        if (!std::isfinite(cal.K.val[k]))
+            CV_Error(Error::StsBadArg, path + ": key 'camera_matrix' has a value that is not "
+                     "finite");
+    if (!(cal.K(0, 0) > 0) || !(cal.K(1, 1) > 0))
+        CV_Error(Error::StsBadArg, path + cv::format(": key 'camera_matrix': the focal lengths "
+                 "fx = %g, fy = %g must be positive", cal.K(0, 0), cal.K(1, 1)));
+    if (cal.K(1, 0) != 0 || cal.K(2, 0) != 0 || cal.K(2, 1) != 0 || cal.K(2, 2) != 1)
+        CV_Error(Error::StsBadArg, path + ": key 'camera_matrix' must be (fx, s, cx; 0, fy, cy; "
+                 "0, 0, 1)");
+    {
+        const Mat D = readMatKey(root, "distortion_coefficients", path);
+        const int n = (int)D.total();
+        if (D.channels() != 1 || (D.rows != 1 && D.cols != 1) ||
+            (n != 4 && n != 5 && n != 8 && n != 12 && n != 14))
+            CV_Error(Error::StsBadSize, path + cv::format(": key 'distortion_coefficients' must "
+                     "be 1xN or Nx1 with N in 4, 5, 8, 12, 14, got %dx%d with %d channel(s)",
+                     D.rows, D.cols, D.channels()));
+        if (D.depth() != CV_64F && D.depth() != CV_32F)
+            CV_Error(Error::StsUnsupportedFormat, path + ": key 'distortion_coefficients' must "
+                     "be a floating point matrix");
+        Mat D64;
+        D.reshape(1, 1).convertTo(D64, CV_64F);
+        cal.distortion.assign(D64.ptr<double>(), D64.ptr<double>() + n);
+        for (double d : cal.distortion)
+            if (!std::isfinite(d))
+                CV_Error(Error::StsBadArg, path + ": key 'distortion_coefficients' has a value "
+                         "that is not finite");
+    }
+    const bool hasW = !root["image_width"].empty() && !root["image_width"].isNone();
+    const bool hasH = !root["image_height"].empty() && !root["image_height"].isNone();
+    if (hasW != hasH)
+        CV_Error(Error::StsParseError, path + ": keys 'image_width' and 'image_height' go "
+                 "together, only '" + String(hasW ? "image_width" : "image_height") + "' given");
+    Size calSize = frameSize;
+    if (hasW)
+    {
+        calSize = Size(readIntKey(root, "image_width", path), readIntKey(root, "image_height",
+                       path));
+        if (calSize.width <= 0 || calSize.height <= 0)
+            CV_Error(Error::StsBadArg, path + cv::format(": keys 'image_width', 'image_height' "
+                     "= %d x %d must be positive", calSize.width, calSize.height));
+    }
+    cal.imageSize = calSize;
+    if (frameSize.empty() || calSize == frameSize)
+        return cal;
+    // Another resolution: the same aspect when the scaled height rounds to the frames' (half a
+    // pixel); per-axis scale in the pixel-centre convention, c' = r (c + 0.5) - 0.5.
+    const double rx = (double)frameSize.width / calSize.width;
+    const double ry = (double)frameSize.height / calSize.height;
+    if (std::abs(calSize.height * rx - frameSize.height) > 0.5)
+        CV_Error(Error::StsBadSize, path + cv::format(": keys 'image_width', 'image_height': "
+                 "calibrated at %d x %d, another aspect than the frames' %d x %d",
+                 calSize.width, calSize.height, frameSize.width, frameSize.height));
+    cal.K(0, 0) *= rx;
+    cal.K(0, 1) *= rx;
+    cal.K(0, 2) = rx * (cal.K(0, 2) + 0.5) - 0.5;
+    cal.K(1, 1) *= ry;
+    cal.K(1, 2) = ry * (cal.K(1, 2) + 0.5) - 0.5;
+    cal.imageSize = frameSize;
+    return cal;
+}
+
 ObjectMasks readMasks(const String& dir, Size expectedSize)
 {
     if (!fs::is_directory(dir))

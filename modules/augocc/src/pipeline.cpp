@@ -308,6 +308,11 @@ RunResult runPipeline(const RunOptions& o)
     VirtualScene scene;
     if (!o.scenePath.empty())
         scene = readScene(o.scenePath);
+    SfmOptions sfm;
+    if (!o.calibrationPath.empty())
+        sfm.calibration = readCalibration(o.calibrationPath, src->size());
+    sfm.focal = o.focal;
+    sfm.refineIntrinsics = o.refineIntrinsics;
     // An output folder made here and still empty when a stage fails goes again. Intermediate
     // files already written stay: each is complete (written atomically) and re-runs by hand.
     struct EmptyDirGuard
@@ -338,7 +343,7 @@ RunResult runPipeline(const RunOptions& o)
 
     timer.start();
     progress("sfm", 0, 1);
-    r.reconstruction = recoverCameras(r.tracks);
+    r.reconstruction = recoverCameras(r.tracks, sfm, &r.sfm);
     writeReconstruction((dir / "reconstruction.yml").string(), r.reconstruction);
     progress("sfm", 1, 1);
     timer.stop("sfm");

@@ -284,6 +284,60 @@ struct PerspectiveStrengthError
     double u_, v_, cx_, cy_;
 };
 
+/** @brief Pinhole with OpenCV's lens distortion, exactly as Camera::project (and
+cv::projectPoints) apply it: the residual of the lens bundle adjustment (camera_refiner.cpp).
+Blocks: q (4, rotation world->camera, (x, y, z, w)), t (3), X (3, world point), intrinsics (3:
+f = fx, cx, cy), distortion (12: k1, k2, p1, p2, k3, k4, k5, k6, s1, s2, s3, s4; zeros for the
+terms a camera does not have). Constants: fy / fx and skew / fx (one focal block for the
+sequence keeps the calibration's aspect), and the tilt homography of tx, ty (14-coefficient
+lenses; identity otherwise), which is never refined. Residual (2): projected - observed, pixels.
+Automatic differentiation (a few 10k observations; analytic Jacobians would save time only). */
+struct LensReprojectionError
+{
+    LensReprojectionError(double u, double v, double aspect, double skew, const Matx33d& tilt)
+        : u_(u), v_(v), aspect_(aspect), skew_(skew), tilt_(tilt),
+          hasTilt_(tilt != Matx33d::eye()) {}
+
+    template <typename T>
+    bool operator()(const T* const q, const T* const t, const T* const X, const T* const intr,
+                    const T* const k, T* residuals) const
+    {
+        const Eigen::Map<const Eigen::Quaternion<T>> Q(q);
+        const Eigen::Map<const Eigen::Matrix<T, 3, 1>> P(X);
+        const Eigen::Matrix<T, 3, 1> Xc = Q * P + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t);
+        const T x = Xc(0) / Xc(2), y = Xc(1) / Xc(2);
+        const T r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2;
+        const T radial = (T(1) + k[0] * r2 + k[1] * r4 + k[4] * r6) /
+                         (T(1) + k[5] * r2 + k[6] * r4 + k[7] * r6);
+        T xd = x * radial + T(2) * k[2] * x * y + k[3] * (r2 + T(2) * x * x) + k[8] * r2 +
+               k[9] * r4;
+        T yd = y * radial + k[2] * (r2 + T(2) * y * y) + T(2) * k[3] * x * y + k[10] * r2 +
+               k[11] * r4;
+        if (hasTilt_)
+        {
+            const T hx = T(tilt_(0, 0)) * xd + T(tilt_(0, 1)) * yd + T(tilt_(0, 2));
+            const T hy = T(tilt_(1, 0)) * xd + T(tilt_(1, 1)) * yd + T(tilt_(1, 2));
+            const T hw = T(tilt_(2, 0)) * xd + T(tilt_(2, 1)) * yd + T(tilt_(2, 2));
+            xd = hx / hw;
+            yd = hy / hw;
+        }
+        residuals[0] = intr[0] * (xd + T(skew_) * yd) + intr[1] - T(u_);
+        residuals[1] = intr[0] * T(aspect_) * yd + intr[2] - T(v_);
+        return true;
+    }
+
+    static ceres::CostFunction* Create(double u, double v, double aspect, double skew,
+                                       const Matx33d& tilt)
+    {
+        return new ceres::AutoDiffCostFunction<LensReprojectionError, 2, 4, 3, 3, 3, 12>(
+            new LensReprojectionError(u, v, aspect, skew, tilt));
+    }
+
+    double u_, v_, aspect_, skew_;
+    Matx33d tilt_;
+    bool hasTilt_;
+};
+
 /** Relative accuracy of the bundle adjustments' inexact Newton steps (Ceres'
 Solver::Options::eta) and the conjugate-gradient steps allowed for one (Ceres' default: 500), for
 every iterative adjustment (camera_refiner.cpp, incremental_sfm.cpp). Well-conditioned problems

@@ -54,6 +54,15 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
     if (!(orthoDistanceRatio > 1))
         CV_Error(Error::StsBadArg, "writeColmapModel: orthoDistanceRatio must be > 1");
     const Mat colors = checkColors(colorsArg, rec.points.rows, "writeColmapModel");
+    // Lenses: COLMAP's OPENCV (k1, k2, p1, p2) and FULL_OPENCV (k3..k6 too) are OpenCV's own
+    // model of the normalised point; thin prism and tilt terms have no COLMAP model.
+    for (const Camera& cam : rec.cameras)
+        for (size_t k = 8; k < cam.distortion.size(); k++)
+            if (cam.distortion[k] != 0)
+                CV_Error(Error::StsNotImplemented, cv::format("writeColmapModel: the camera of "
+                         "frame %d has thin prism or tilt distortion (coefficient %d of %d is "
+                         "not zero), which no COLMAP camera model expresses", cam.frame,
+                         (int)k + 1, (int)cam.distortion.size()));
     detail::createDirectories(dir);
     const int P = rec.points.rows;
     Vec3d c;
@@ -131,9 +140,24 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
             out << cv::format("# scaled_orthographic cameras approximated by PINHOLE at %g "
                               "x the scene's RMS radius\n", orthoDistanceRatio);
         for (const Camera& cam : cams)
-            out << cam.frame + 1 << " PINHOLE " << rec.imageSize.width << ' '
+        {
+            const std::vector<double>& d = cam.distortion;
+            const bool full = d.size() >= 8 && (d[4] != 0 || d[5] != 0 || d[6] != 0 ||
+                                                d[7] != 0);
+            const bool full5 = d.size() == 5 && d[4] != 0;
+            const char* model = !cam.hasDistortion() ? "PINHOLE"
+                                : (full || full5) ? "FULL_OPENCV" : "OPENCV";
+            out << cam.frame + 1 << ' ' << model << ' ' << rec.imageSize.width << ' '
                 << rec.imageSize.height << ' ' << cam.K(0, 0) << ' ' << cam.K(1, 1) << ' '
-                << cam.K(0, 2) + 0.5 << ' ' << cam.K(1, 2) + 0.5 << '\n';
+                << cam.K(0, 2) + 0.5 << ' ' << cam.K(1, 2) + 0.5;
+            if (cam.hasDistortion())
+            {
+                const int n = (full || full5) ? 8 : 4;
+                for (int k = 0; k < n; k++)
+                    out << ' ' << (k < (int)d.size() ? d[k] : 0.0);
+            }
+            out << '\n';
+        }
         writeText(out, tmp, dir + "/cameras.txt");
     });
     writeAtomically(dir + "/points3D.txt", [&](const String& tmp) {

@@ -135,6 +135,38 @@ struct CV_EXPORTS SfmOptions
     double autoRatio = 0.9;
     FactorizationSfM::Params factorization;  //!< settings of the factorization stage
     OrthoCameraRefiner::Params refiner;  //!< loss and iteration settings shared by the stages
+    /** Known intrinsics (`--calibration`, readCalibration() for the tracks' image size): the
+    observations are undistorted with them for the affine and perspective stages, the model is
+    perspective, and a last bundle adjustment of the pinhole with this lens on the original
+    (distorted) observations gives the cameras, which carry `calibration.K` and its
+    distortion. Empty `calibration.imageSize`: unknown (see `focal`). */
+    Calibration calibration;
+    /** Known focal length only (`--focal`), pixels, fx = fy, principal point at the image
+    centre, no distortion; 0: unknown. Exclusive with `calibration`. */
+    double focal = 0;
+    /** With known intrinsics: also refine the focal length (one, the calibration's fy / fx and
+    skew kept) and the distortion coefficients the calibration has (all but the tilt tx, ty);
+    the principal point stays. false: the given intrinsics stay fixed. */
+    bool refineIntrinsics = false;
+    /** Without known intrinsics and when the perspective model is kept: self-calibration, a
+    lens bundle adjustment of the focal (fx = fy, principal point at the image centre) and the
+    radial k1, k2 (COLMAP's RADIAL). The lens kept is the one of {focal only, focal + k1,
+    focal + k1 + k2} with the lowest BIC, N log(RSS / N) + p log N over the N residual
+    coordinates of the observations within `lensInlierPx` of the richest model's reprojection
+    (the same set for all; p counts the lens parameters beyond the focal; focal + k1 + k2 is fitted
+only when focal + k1 beat the focal alone), so that a
+    coefficient is kept only when it explains more than noise does (a chance drop of the RSS by
+    one parameter is chi-square(1) sigma^2, the penalty log N sigma^2). "focal only" keeps the
+    perspective solution unchanged. The kept lens is dropped again (the prior, the perspective
+    solution, stays) when the focal's relative standard deviation from the Gauss-Newton
+    covariance (ceres::Covariance, residuals scaled to their RMS) exceeds `maxFocalRelStd`:
+    too little depth variation or rotation to tell the focal from the distance. false: no
+    self-calibration (the perspective solution as before). */
+    bool selfCalibrate = true;
+    //! Self-calibration: inlier threshold of the BIC, pixels (> 0).
+    double lensInlierPx = 3.0;
+    //! Self-calibration: largest relative standard deviation of the focal that is trusted.
+    double maxFocalRelStd = 0.01;
 };
 
 //! What recoverCameras() did.
@@ -150,10 +182,37 @@ struct CV_EXPORTS SfmReport
     ReprojectionStats orthographic;   //!< after the scaled-orthographic BA (if run)
     ReprojectionStats perspective;    //!< after the perspective BA (if run)
     String chosenModel;               //!< "scaled_orthographic" or "perspective"
+    /** Lens of the output cameras: "none" (scaled orthographic), "focal" (the perspective
+    solution's focal, no distortion), "focal_k1", "focal_k1_k2" (self-calibrated), "given"
+    (known intrinsics, fixed) or "given_refined" (`refineIntrinsics`). */
+    String lensModel;
+    double focal = 0;                 //!< focal length fx of the output cameras, pixels (0: none)
+    std::vector<double> distortion;   //!< distortion coefficients of the output cameras
+    //! why this lens (the BIC figures, or why the prior was kept), one sentence for the log
+    String lensReason;
+    //! relative standard deviation of the self-calibrated focal (0: not computed)
+    double focalRelStd = 0;
+    //! BIC of the models tried, in the order focal, focal_k1, focal_k1_k2 (self-calibration
+    //! only; empty otherwise)
+    std::vector<double> lensBic;
+    //! after the lens bundle adjustment (if run), against the original observations
+    ReprojectionStats lens;
 };
 
-/** @brief Factorization, the paper's 3F+1 refinement, optional full bundle adjustment and model
-selection: what `augocc sfm` and `augocc run` call.
+/** @brief Factorization, the paper's 3F+1 refinement, optional full bundle adjustment, model
+selection and the lens: what `augocc sfm` and `augocc run` call.
+
+Steps:
+1. Known intrinsics (SfmOptions::calibration or SfmOptions::focal): the observations are
+   undistorted (Camera::undistortPixel) and brought to a square-pixel pinhole with the principal
+   point at the image centre, for the stages below (their ReprojectionStats are against these).
+2. Factorization, 3F+1, scaled-orthographic BA, depth-reversal prior, perspective BA and the
+   `auto` model choice (forced perspective with known intrinsics).
+3. Known intrinsics: a pinhole + distortion bundle adjustment (poses on the quaternion manifold,
+   points, the refiner's robust loss) on the original, distorted observations, the intrinsics
+   held (or refined with SfmOptions::refineIntrinsics). Unknown: the self-calibration of
+   SfmOptions::selfCalibrate when the perspective model was kept.
+4. The rejected tracks the final cameras explain are kept (through the lens).
 @param tracks the tracks.
 @param options see SfmOptions.
 @param report optional: what was done and the error after each stage.

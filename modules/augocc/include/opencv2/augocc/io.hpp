@@ -76,6 +76,49 @@ struct CV_EXPORTS Reconstruction
     void validate(const String& what = String()) const;
 };
 
+/** @brief Known intrinsics: OpenCV's calibration file (contract: calibration.yml), as
+`cv::calibrateCamera` users save it, brought to the size of the frames.
+
+Pixel convention of the module (origin at the centre of the top-left pixel): a calibration made
+at another resolution of the same aspect is scaled per axis with r = frame / calibration size as
+c' = r * (c + 0.5) - 0.5 and f' = r * f; the distortion coefficients act on normalised
+coordinates and are unchanged.
+*/
+struct CV_EXPORTS Calibration
+{
+    Matx33d K = Matx33d::eye();       //!< intrinsics (fx, skew, cx; 0, fy, cy; 0, 0, 1), pixels
+    //! OpenCV's distortion coefficients (Camera::distortion): 0, 4, 5, 8, 12 or 14 values
+    std::vector<double> distortion;
+    Size imageSize;                   //!< the size K is expressed for, pixels
+
+    //! A perspective camera with these intrinsics and the given pose.
+    //! @param R rotation, world to camera. @param t translation, world to camera.
+    //! @param frame frame index.
+    Camera camera(const Matx33d& R = Matx33d::eye(), const Vec3d& t = Vec3d(0, 0, 0),
+                  int frame = 0) const
+    {
+        return Camera::perspective(R, t, K, frame, distortion);
+    }
+};
+
+/** @brief Reads OpenCV's calibration file (also .yml.gz / .json / .xml) for frames of
+`frameSize`.
+
+Keys: `camera_matrix` (3x3, fx > 0, fy > 0, finite, last row 0 0 1), `distortion_coefficients`
+(1xN or Nx1, N in 4, 5, 8, 12, 14, finite), optional `image_width` and `image_height` (the size
+it was calibrated at; both or neither). Other keys are ignored.
+@param path the file.
+@param frameSize size of the frames the intrinsics are for; when the file gives another size of
+the same aspect (within half a pixel) K is scaled to it (see Calibration), another aspect is
+StsBadSize naming both sizes. Empty: K is returned as read.
+@return the intrinsics for `frameSize` (imageSize = frameSize, or the file's size when
+`frameSize` is empty).
+Throws cv::Exception naming the file and the key: StsObjectNotFound / StsParseError (missing
+file, missing key, not a matrix), StsBadSize (matrix shape, coefficient count, sizes), StsBadArg
+(NaN or infinite values, focal not positive).
+*/
+CV_EXPORTS Calibration readCalibration(const String& path, Size frameSize = Size());
+
 //! Per-frame 8-bit masks of one object: frame index -> image (255 = object).
 typedef std::map<int, Mat> FrameMasks;
 //! Masks of several objects: object name -> its frames.

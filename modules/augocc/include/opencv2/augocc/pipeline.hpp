@@ -7,6 +7,7 @@
 #include <functional>
 #include <vector>
 #include <opencv2/core.hpp>
+#include "opencv2/augocc/camera_refiner.hpp"
 #include "opencv2/augocc/clone_builder.hpp"
 #include "opencv2/augocc/compositor.hpp"
 #include "opencv2/augocc/io.hpp"
@@ -88,6 +89,11 @@ struct CV_EXPORTS RunOptions
     bool antialiasVirtual = Compositor::Params().antialiasVirtual;
     //! Carve the clones further by photo-consistency over every frame (CloneBuilder::refine).
     bool photoRefine = true;
+    /** Known intrinsics: OpenCV's calibration file (readCalibration(), scaled to the frames),
+    read before any stage; empty: none (SfmOptions::calibration). */
+    String calibrationPath;
+    double focal = 0;               //!< known focal only, pixels (SfmOptions::focal); 0: none
+    bool refineIntrinsics = false;  //!< SfmOptions::refineIntrinsics
     //! Stage progress: (stage name, done, total); a stage starts with done = 0.
     std::function<void(const String& stage, int done, int total)> progress;
 };
@@ -97,6 +103,7 @@ struct CV_EXPORTS RunResult
 {
     Tracks tracks;                      //!< as written to tracks.yml
     Reconstruction reconstruction;      //!< as written to reconstruction.yml
+    SfmReport sfm;                      //!< what recoverCameras() did (lens model and why)
     Ptr<CloneSet> clones;               //!< as written to clones.yml.gz
     std::vector<Mesh> virtualObjects;   //!< placed, world frame of the reconstruction
     String compositePath;               //!< empty without a scene

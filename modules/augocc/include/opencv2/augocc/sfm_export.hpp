@@ -19,7 +19,12 @@ namespace augocc {
 and in tools that read COLMAP models.
 
 - One COLMAP camera per frame (CAMERA_ID = IMAGE_ID = frame + 1), model PINHOLE
-  (fx, fy, cx, cy). Image names are `%04d.png` of the frame index (the frames folder written
+  (fx, fy, cx, cy) for a camera without lens distortion; a distorted camera is COLMAP's
+  `OPENCV` (fx, fy, cx, cy, k1, k2, p1, p2), or `FULL_OPENCV` (..., k3, k4, k5, k6) when it has
+  a non-zero k3..k6: both are OpenCV's model of the normalised point, so the observations are
+  written as filmed. Thin prism and tilt coefficients (s1..s4, tx, ty) have no COLMAP model:
+  StsNotImplemented naming the frame, before anything is written. Skew is not written (COLMAP
+  has none). Image names are `%04d.png` of the frame index (the frames folder written
   by `augocc synth`).
 - COLMAP's pixel origin is the top-left corner of the image (the centre of the first pixel is
   (0.5, 0.5)); the contract's is the centre of the first pixel, so 0.5 is added to every image
