@@ -829,7 +829,9 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     options.eta = detail::kBundleForcing;
     options.max_num_iterations = params.maxIterations;
     options.function_tolerance = params.functionTolerance;
-    options.num_threads = cv::getNumThreads();
+    // One thread, as the other bundle adjustments here: Ceres' threaded sums change the last
+    // digits with the thread count, and results must not depend on it.
+    options.num_threads = 1;
     options.minimizer_progress_to_stdout = false;
     options.logging_type = ceres::SILENT;
     double finalCost = 0;
@@ -853,7 +855,7 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
         *focalRelStd = -1;
         ceres::Covariance::Options co;
         co.algorithm_type = ceres::SPARSE_QR;
-        co.num_threads = cv::getNumThreads();
+        co.num_threads = 1;  // as the solve: no dependence on the thread count
         ceres::Covariance cov(co);
         std::vector<std::pair<const double*, const double*>> blocks = {{intr, intr}};
         double C[9];
