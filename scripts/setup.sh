@@ -15,7 +15,7 @@ PACKAGES=(
     libbenchmark-dev                      # perf suite
     python3                               # perf comparison and contact-sheet scripts (stdlib only)
     xvfb xdotool                          # end-to-end test of the interactive annotate tool
-    ffmpeg                                # ffprobe for video checks in tests
+    ffmpeg                                # ffprobe for video checks in tests; ffmpeg for synth --bitrate
     doxygen texlive-base                  # API docs and their test (bibtex for @cite)
 )
 

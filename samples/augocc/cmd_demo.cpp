@@ -26,17 +26,26 @@ void registerDemo(CLI::App& app, Globals& g)
     sub->add_flag("--no-photo-refine", *noPhoto, "clones from the silhouettes alone (no "
                   "photo-consistency carving over the frames)");
     sub->add_option("--model", *model, "camera of the synthesized footage: scaled_orthographic "
-                    "(default) or perspective");
-    sub->add_option("--distance-ratio", *distance, "camera distance over the scene size (default "
+                    "(default), perspective, or handheld (street-level hand-held 1280x720 "
+                    "through a k1 = -0.12 lens, 1.5 scene sizes away, exposure and "
+                    "white-balance drift, H.264 at 8 Mbit/s)");
+    CLI::Option* distanceOpt = sub->add_option("--distance-ratio", *distance, "camera distance over the scene size (default "
                     "10; 3 is hand-held footage near the buildings, strong perspective)");
-    sub->callback([&g, outDir, noPhoto, model, distance]() {
-        DemoOptions o;
-        if (*model != "scaled_orthographic" && *model != "perspective")
-            throw UsageError("--model " + *model + ": expected scaled_orthographic or perspective");
+    sub->callback([&g, outDir, noPhoto, model, distance, distanceOpt]() {
+        const bool handheld = *model == "handheld";
+        DemoOptions o = handheld ? handheldDemoOptions() : DemoOptions();
+        if (*model != "scaled_orthographic" && *model != "perspective" && !handheld)
+            throw UsageError("--model " + *model + ": expected scaled_orthographic, perspective "
+                             "or handheld");
         if (!(*distance >= 1.0))
             throw UsageError(cv::format("--distance-ratio %g: must be >= 1", *distance));
-        o.model = *model == "perspective" ? PERSPECTIVE : SCALED_ORTHOGRAPHIC;
-        o.distanceRatio = *distance;
+        if (!handheld)
+        {
+            o.model = *model == "perspective" ? PERSPECTIVE : SCALED_ORTHOGRAPHIC;
+            o.distanceRatio = *distance;
+        }
+        else if (distanceOpt->count() > 0)
+            o.distanceRatio = *distance;
         o.outDir = *outDir;
         o.photoRefine = !*noPhoto;
         std::shared_ptr<Progress> current;
@@ -50,6 +59,9 @@ void registerDemo(CLI::App& app, Globals& g)
         info(g, "composite:     " + r.compositePath);
         info(g, "contact sheet: " + r.contactSheetPath);
         info(g, "scene file:    " + r.scenePath);
+        if (!r.calibrationPath.empty())
+            info(g, "calibration:   " + r.calibrationPath + " (true intrinsics; not used by "
+                 "this run)");
         info(g, cv::format("accuracy against the synthetic ground truth: %.2f%% of pixels within "
                            "8 grey levels, occlusion boundary %.2f px (mean over the %d frames "
                            "with one), camera rotation error %.3f deg", 100 * r.fractionWithin,

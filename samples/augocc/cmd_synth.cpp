@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include "opencv2/augocc.hpp"
@@ -37,6 +38,11 @@ struct SynthOptions
     double orbit = kDefaults.orbitDegrees;
     double elevation = kDefaults.elevationDegrees;
     std::string contactSheet;
+    std::string distortion;
+    std::string path = "orbit";
+    double exposureDrift = kDefaults.exposureDrift;
+    double whiteBalanceDrift = kDefaults.whiteBalanceDrift;
+    double bitrate = kDefaults.videoBitrateMbps;
 };
 
 // Contact sheet: frames shown, columns, thumbnail width, outline colours per object (BGR).
@@ -54,6 +60,25 @@ Size parseSize(const std::string& s)
         h <= 0)
         throw UsageError("--size " + s + ": expected WIDTHxHEIGHT, e.g. 640x480");
     return Size(w, h);
+}
+
+// "k1,k2,p1,p2[,k3...]": OpenCV's coefficients, 4, 5, 8, 12 or 14 of them (the library checks
+// the count and says which).
+std::vector<double> parseDistortion(const std::string& s)
+{
+    std::vector<double> d;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ','))
+    {
+        char* end = nullptr;
+        const double v = std::strtod(item.c_str(), &end);
+        if (item.empty() || end == item.c_str() || *end != 0 || !std::isfinite(v))
+            throw UsageError("--distortion " + s + ": expected comma-separated numbers "
+                             "k1,k2,p1,p2[,k3...], e.g. -0.12,0,0,0,0");
+        d.push_back(v);
+    }
+    return d;
 }
 
 Mat contactSheet(const SyntheticScene& scene)
@@ -102,6 +127,15 @@ void runSynth(const Globals& g, const SynthOptions& o)
     p.frameSupersample = o.supersample;
     p.orbitDegrees = o.orbit;
     p.elevationDegrees = o.elevation;
+    if (!o.distortion.empty())
+        p.distortion = parseDistortion(o.distortion);
+    if (o.path == "handheld")
+        p.path = SceneSynthesizer::PATH_HANDHELD;
+    else if (o.path != "orbit")
+        throw UsageError("--path " + o.path + ": expected orbit or handheld");
+    p.exposureDrift = o.exposureDrift;
+    p.whiteBalanceDrift = o.whiteBalanceDrift;
+    p.videoBitrateMbps = o.bitrate;
     Ptr<SceneSynthesizer> synth;
     try
     {
@@ -115,10 +149,15 @@ void runSynth(const Globals& g, const SynthOptions& o)
             {"partialFraction", "--partial"}, {"outlierFraction", "--outliers"},
             {"numTracks", "--tracks"}, {"numKeyFrames", "--key-frames"},
             {"distanceRatio", "--distance-ratio"}, {"frameSupersample", "--supersample"},
-            {"orbitDegrees", "--orbit"}, {"elevationDegrees", "--elevation"}};
+            {"orbitDegrees", "--orbit"}, {"elevationDegrees", "--elevation"},
+            {"distortion", "--distortion"}, {"path", "--path"},
+            {"exposureDrift", "--exposure-drift"},
+            {"whiteBalanceDrift", "--white-balance-drift"}, {"videoBitrateMbps", "--bitrate"}};
         std::string flag;
         for (const auto& kv : kFlags)
-            if (e.err.find(std::string(kv.first) + " must") != std::string::npos)
+            if (e.err.find(std::string(kv.first) + " must") != std::string::npos ||
+                e.err.find(std::string(kv.first) + " needs") != std::string::npos ||
+                e.err.find(std::string(kv.first) + ":") != std::string::npos)
                 flag = std::string(kv.second) + ": ";
         throw UsageError("synth: " + flag + e.err);
     }
@@ -189,6 +228,18 @@ void registerSynth(CLI::App& app, Globals& g)
     sub->add_option("--supersample", o->supersample,
                     "render frames K x K times finer and average down (anti-aliased)")
         ->capture_default_str();
+    sub->add_option("--distortion", o->distortion,
+                    "lens distortion k1,k2,p1,p2[,k3...] (OpenCV's model; perspective only)");
+    sub->add_option("--path", o->path, "camera path: orbit (far, smooth) or handheld (street "
+                    "level, sway, wobble and roll; perspective only)")->capture_default_str();
+    sub->add_option("--exposure-drift", o->exposureDrift,
+                    "auto-exposure: frame gain ramps from 1 to 1 + this over the shot")
+        ->capture_default_str();
+    sub->add_option("--white-balance-drift", o->whiteBalanceDrift,
+                    "white balance: red gain 1 + w, blue 1 - w, w ramping from 0 to this")
+        ->capture_default_str();
+    sub->add_option("--bitrate", o->bitrate, "video.mp4 bit rate, Mbit/s (H.264 by the ffmpeg "
+                    "tool; a phone's 8-16 at 1080p); 0 = OpenCV's writer")->capture_default_str();
     sub->add_option("--contact-sheet", o->contactSheet,
                     "also write a PNG of 8 frames with the GT silhouettes outlined");
     sub->callback([&g, o]() { runSynth(g, *o); });

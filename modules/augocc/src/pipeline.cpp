@@ -441,6 +441,23 @@ VirtualScene demoVirtualScene(const String& path)
     return s;
 }
 
+DemoOptions handheldDemoOptions()
+{
+    DemoOptions o;
+    o.imageSize = Size(1280, 720);
+    o.frames = 90;
+    o.numKeyFrames = 6;
+    o.model = PERSPECTIVE;
+    o.path = SceneSynthesizer::PATH_HANDHELD;
+    o.distanceRatio = 1.5;
+    o.orbitDegrees = 30;
+    o.distortion = {-0.12, 0, 0, 0, 0};
+    o.exposureDrift = 0.15;
+    o.whiteBalanceDrift = 0.05;
+    o.videoBitrateMbps = 8;
+    return o;
+}
+
 DemoResult runDemo(const DemoOptions& o)
 {
     DemoResult res;
@@ -451,6 +468,13 @@ DemoResult runDemo(const DemoOptions& o)
     sp.imageSize = o.imageSize;
     sp.model = o.model;
     sp.distanceRatio = o.distanceRatio;
+    sp.path = o.path;
+    sp.orbitDegrees = o.orbitDegrees;
+    sp.numKeyFrames = o.numKeyFrames;
+    sp.distortion = o.distortion;
+    sp.exposureDrift = o.exposureDrift;
+    sp.whiteBalanceDrift = o.whiteBalanceDrift;
+    sp.videoBitrateMbps = o.videoBitrateMbps;
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
     SyntheticScene scene;
     if (o.progress)
@@ -458,15 +482,28 @@ DemoResult runDemo(const DemoOptions& o)
     synth->synthesize(scene);
     if (o.progress)
         o.progress("synth", 1, 1);
-    // The input: frames as PNG (lossless), key-frame masks, the scene file.
-    const String framesDir = (dir / "input" / "frames").string();
-    writeAtomically(framesDir, [&](const String& tmp) {
-        detail::createDirectories(tmp, framesDir);
-        for (size_t f = 0; f < scene.frames.size(); f++)
-            writeImage(tmp, framesDir, cv::format("%04d.png", (int)f), scene.frames[f]);
-    });
-    const String masksDir = (dir / "input" / "masks").string();
-    writeMasks(masksDir, scene.keyFrameMasks);
+    // The input: frames as PNG (lossless) or, at a set bit rate, the synthesized data set with
+    // its H.264 video (a user's footage) and calibration.yml; key-frame masks, the scene file.
+    String framesDir = (dir / "input" / "frames").string();
+    String masksDir = (dir / "input" / "masks").string();
+    if (o.videoBitrateMbps > 0)
+    {
+        const String synthDir = (dir / "synth").string();
+        writeSyntheticScene(synthDir, scene, sp);
+        framesDir = (dir / "synth" / "video.mp4").string();
+        masksDir = (dir / "synth" / "input" / "masks").string();
+    }
+    else
+    {
+        writeAtomically(framesDir, [&](const String& tmp) {
+            detail::createDirectories(tmp, framesDir);
+            for (size_t f = 0; f < scene.frames.size(); f++)
+                writeImage(tmp, framesDir, cv::format("%04d.png", (int)f), scene.frames[f]);
+        });
+        writeMasks(masksDir, scene.keyFrameMasks);
+    }
+    if (sp.model == PERSPECTIVE && o.videoBitrateMbps > 0)
+        res.calibrationPath = (dir / "synth" / "calibration.yml").string();
     res.scenePath = (dir / "scene.yml").string();
     writeScene(res.scenePath, demoVirtualScene(res.scenePath));
 

@@ -340,6 +340,7 @@ struct SceneModel
     double size = 10;           // footprint diameter of the objects (world units)
     double distance = 100;      // camera distance from the centre
     double scale = 1;           // SCALED_ORTHOGRAPHIC s (pixels per world unit); f = s * D
+    double handHeight = 1;      // PATH_HANDHELD: camera height above the ground
     std::vector<Camera> cameras;
     std::vector<Vec3f> boundCorners;  // corners of the objects' boxes and of the ground
 };
@@ -431,6 +432,77 @@ double smoothJitter(double t, const Vec4d& phase)
            0.4 * std::sin(2 * kPi * 3.7 * t + phase[1]);
 }
 
+// Intrinsics of every path: the principal point at the image centre, f = s * D (the framing of
+// the scaled orthographic camera at the scene centre), the lens of Params::distortion.
+Camera finishCamera(const SceneSynthesizer::Params& p, const SceneModel& m, const Matx33d& R,
+                    const Vec3d& C, int f)
+{
+    const Vec3d tv = -(R * C);
+    const Point2d pp((p.imageSize.width - 1) * 0.5, (p.imageSize.height - 1) * 0.5);
+    if (p.model == SCALED_ORTHOGRAPHIC)
+        return Camera::orthographic(R, tv, m.scale, pp, f);
+    const double fl = m.scale * m.distance;
+    return Camera::perspective(R, tv, Matx33d(fl, 0, pp.x, 0, fl, pp.y, 0, 0, 1), f,
+                               p.distortion);
+}
+
+// World-to-camera rotation of a camera looking along `forward` (world), image y towards the
+// ground, rolled by `roll` radians about its axis.
+Matx33d lookRotation(const Vec3d& forward, double roll)
+{
+    const Vec3d z = cv::normalize(forward);
+    const Vec3d x = cv::normalize(z.cross(Vec3d(0, 1, 0)));
+    const Vec3d y = z.cross(x);
+    const Matx33d R0(x[0], x[1], x[2], y[0], y[1], y[2], z[0], z[1], z[2]);
+    const double c = std::cos(roll), s = std::sin(roll);
+    return Matx33d(c, -s, 0, s, c, 0, 0, 0, 1) * R0;
+}
+
+// PATH_HANDHELD: the smooth motions of a hand, each a sum of three sinusoids (cycles per shot,
+// weights summing to 1, so |value| <= 1 and the peak is the stated amplitude), phases from the
+// seed. The frequencies are low (a walker's sway, not the 2 Hz step: the phone's stabiliser
+// removes that) and incommensurate, so no two motions repeat together.
+const double kHandFreq[3] = {0.6, 1.45, 3.2};
+const double kHandWeight[3] = {0.55, 0.3, 0.15};
+enum HandMotion { HAND_SWAY_X, HAND_SWAY_Y, HAND_SWAY_Z, HAND_YAW, HAND_PITCH, HAND_ROLL,
+                  HAND_MOTIONS };
+
+double handMotion(double t, const Vec3d& phase)
+{
+    double v = 0;
+    for (int k = 0; k < 3; k++)
+        v += kHandWeight[k] * std::sin(2 * kPi * kHandFreq[k] * t + phase[k]);
+    return v;
+}
+
+Camera makeHandheldCamera(const SceneSynthesizer::Params& p, const SceneModel& m,
+                          const std::vector<Vec3d>& phases, int f)
+{
+    typedef SceneSynthesizer S;
+    const double t = (double)f / (p.frames - 1);
+    const double az = (p.orbitDegrees * (t - 0.5)) * kPi / 180;
+    const Vec3d sway(S::kHandheldSwayUnits * handMotion(t, phases[HAND_SWAY_X]),
+                     S::kHandheldSwayUnits * handMotion(t, phases[HAND_SWAY_Y]),
+                     S::kHandheldSwayUnits * handMotion(t, phases[HAND_SWAY_Z]));
+    // The walker's arc around the scene centre at the horizontal distance D, at hand height.
+    const Vec3d C = Vec3d(m.centre[0] + m.distance * std::sin(az), m.handHeight,
+                          m.centre[2] + m.distance * std::cos(az)) + sway;
+    const double yaw = S::kHandheldWobbleDeg * handMotion(t, phases[HAND_YAW]) * kPi / 180;
+    const double pitch = S::kHandheldWobbleDeg * handMotion(t, phases[HAND_PITCH]) * kPi / 180;
+    const double roll = S::kHandheldRollDeg * handMotion(t, phases[HAND_ROLL]) * kPi / 180;
+    // Aimed at the scene centre, then wobbled: yaw about the world's up, pitch about the
+    // camera's x axis.
+    const Vec3d toCentre = cv::normalize(m.centre - C);
+    const Matx33d Ryaw(std::cos(yaw), 0, std::sin(yaw), 0, 1, 0, -std::sin(yaw), 0,
+                       std::cos(yaw));
+    const Matx33d R0 = lookRotation(Ryaw * toCentre, 0.0);
+    const Matx33d Rpitch(1, 0, 0, 0, std::cos(pitch), -std::sin(pitch), 0, std::sin(pitch),
+                         std::cos(pitch));
+    const Matx33d Rroll(std::cos(roll), -std::sin(roll), 0, std::sin(roll), std::cos(roll), 0,
+                        0, 0, 1);
+    return finishCamera(p, m, Rroll * Rpitch * R0, C, f);
+}
+
 Camera makeCamera(const SceneSynthesizer::Params& p, const SceneModel& m, const Vec4d& phE,
                   const Vec4d& phR, int f)
 {
@@ -442,19 +514,7 @@ Camera makeCamera(const SceneSynthesizer::Params& p, const SceneModel& m, const 
     const double roll = kJitterRollDeg * smoothJitter(t, phR) * kPi / 180;
     const Vec3d dir(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
     const Vec3d C = m.centre + m.distance * dir;
-    const Vec3d z = -dir;
-    const Vec3d x = cv::normalize(z.cross(Vec3d(0, 1, 0)));
-    const Vec3d y = z.cross(x);
-    const Matx33d R0(x[0], x[1], x[2], y[0], y[1], y[2], z[0], z[1], z[2]);
-    const double c = std::cos(roll), s = std::sin(roll);
-    const Matx33d Rz(c, -s, 0, s, c, 0, 0, 0, 1);
-    const Matx33d R = Rz * R0;
-    const Vec3d tv = -(R * C);
-    const Point2d pp((p.imageSize.width - 1) * 0.5, (p.imageSize.height - 1) * 0.5);
-    if (p.model == SCALED_ORTHOGRAPHIC)
-        return Camera::orthographic(R, tv, m.scale, pp, f);
-    const double fl = m.scale * m.distance;
-    return Camera::perspective(R, tv, Matx33d(fl, 0, pp.x, 0, fl, pp.y, 0, 0, 1), f);
+    return finishCamera(p, m, lookRotation(-dir, roll), C, f);
 }
 
 std::shared_ptr<SceneModel> buildScene(const SceneSynthesizer::Params& p)
@@ -491,6 +551,19 @@ std::shared_ptr<SceneModel> buildScene(const SceneSynthesizer::Params& p)
     const double frameWidth = std::min((double)p.imageSize.width, p.imageSize.height * 4.0 / 3);
     m->scale = kFrameFill * frameWidth / m->size;
 
+    m->handHeight = SceneSynthesizer::kHandheldHeightFraction * hi[1];
+    if (p.path == SceneSynthesizer::PATH_HANDHELD)
+    {
+        // Its own stream: the orbit's jitter (stream 2) stays as it was.
+        RNG handRng(mixSeed(p.seed, 4));
+        std::vector<Vec3d> phases(HAND_MOTIONS);
+        for (Vec3d& ph : phases)
+            for (int k = 0; k < 3; k++)
+                ph[k] = handRng.uniform(0.0, 2 * kPi);
+        for (int f = 0; f < p.frames; f++)
+            m->cameras.push_back(makeHandheldCamera(p, *m, phases, f));
+        return m;
+    }
     RNG camRng(mixSeed(p.seed, 2));
     Vec4d phE, phR;
     for (int k = 0; k < 4; k++)
@@ -559,6 +632,11 @@ struct GlScene
     detail::GlContext ctx;
     std::unique_ptr<detail::GlMesh> ground;
     std::vector<std::unique_ptr<detail::GlMesh>> objects;
+    // Lens distortion: the frame-to-fine-ideal map of the label / depth / mask pass, for the
+    // view and factor it was made for (the intrinsics are the same in every frame).
+    Ptr<const LensView> maskView;
+    int maskFactor = 0;
+    Mat maskMap;
 
     GlScene(Size size, const SceneModel& m) : ctx(size)
     {
@@ -587,6 +665,8 @@ struct PassOutputs
     Mat* labels = nullptr;
     Mat* depth = nullptr;
     std::vector<Mat>* whole = nullptr;
+    //! CV_32F, the colour's size: the fraction of each pixel the extra (virtual) meshes cover
+    Mat* virtualCover = nullptr;
 };
 
 void loadMatrices(const Camera& cam, Size size, double zNear, double zFar)
@@ -619,7 +699,7 @@ void renderPasses(GlScene& gl, const SceneModel& m, const Camera& cam, Size size
     glDisable(GL_BLEND);
     glDisable(GL_DITHER);
     glDisable(GL_COLOR_LOGIC_OP);
-    if (out.bgr || out.labels || out.depth)
+    if (out.bgr || out.labels || out.depth || out.virtualCover)
     {
         glClearColor(kSkyRgb[0], kSkyRgb[1], kSkyRgb[2], 0.f);
         glClearDepth(1.0);
@@ -632,12 +712,20 @@ void renderPasses(GlScene& gl, const SceneModel& m, const Camera& cam, Size size
             o->draw();
         for (const detail::GlMesh* e : extra)
             e->draw();
-        if (out.bgr || out.labels)
+        if (out.bgr || out.labels || out.virtualCover)
         {
             Mat bgra;
             gl.ctx.readColorAlpha(bgra);
             if (out.bgr)
                 cv::cvtColor(bgra, *out.bgr, COLOR_BGRA2BGR);
+            if (out.virtualCover)
+            {
+                // Extra meshes write alpha 255 (GlMesh id 1), the scene's objects (i + 1) / 255.
+                Mat alpha;
+                cv::extractChannel(bgra, alpha, 3);
+                cv::compare(alpha, 255, alpha, CMP_EQ);
+                alpha.convertTo(*out.virtualCover, CV_32F, 1.0 / 255);
+            }
             if (out.labels)
                 cv::extractChannel(bgra, *out.labels, 3);
         }
@@ -690,15 +778,133 @@ void renderSupersampled(GlScene& gl, const SceneModel& m, const Camera& cam, Siz
     }
     PassOutputs rest = out;
     rest.bgr = nullptr;
+    rest.virtualCover = nullptr;
     if (rest.labels || rest.depth || rest.whole)
         renderPasses(gl, m, cam, size, extra, extraCorners, rest);
-    Mat fine;
+    Mat fine, fineCover;
     PassOutputs colour;
     colour.bgr = &fine;
+    if (out.virtualCover)
+        colour.virtualCover = &fineCover;
     renderPasses(gl, m, supersampledCamera(cam, supersample),
                  Size(size.width * supersample, size.height * supersample), extra, extraCorners,
                  colour);
     cv::resize(fine, *out.bgr, size, 0, 0, INTER_AREA);
+    if (out.virtualCover)
+        cv::resize(fineCover, *out.virtualCover, size, 0, 0, INTER_AREA);
+}
+
+// Lens distortion: how much finer than the ideal view labels, depth and masks are rendered.
+int lensMaskFactor(Size idealSize)
+{
+    int k = SceneSynthesizer::kLensMaskSupersample;
+    while (k > 1 && (double)idealSize.area() * k * k > SceneSynthesizer::kLensMaskPixels)
+        k--;
+    return k;
+}
+
+// The map (frame size, CV_32FC2) from each frame pixel to the pixel of the ideal view rendered
+// `factor` times finer that sees its ray; cached in `gl` for the view.
+const Mat& lensMaskMap(GlScene& gl, const Ptr<const LensView>& view, int factor)
+{
+    if (gl.maskView == view && gl.maskFactor == factor)
+        return gl.maskMap;
+    const Size fs = view->frameSize();
+    Mat map(fs, CV_32FC2);
+    parallel_for_(Range(0, fs.height), [&](const Range& r) {
+        for (int y = r.start; y < r.end; y++)
+        {
+            Point2f* row = map.ptr<Point2f>(y);
+            for (int x = 0; x < fs.width; x++)
+            {
+                const Point2d q = view->frameToIdeal(Point2d(x, y));
+                row[x] = Point2f((float)(factor * (q.x + 0.5) - 0.5),
+                                 (float)(factor * (q.y + 0.5) - 0.5));
+            }
+        }
+    });
+    gl.maskView = view;
+    gl.maskFactor = factor;
+    gl.maskMap = map;
+    return gl.maskMap;
+}
+
+/* The passes of one frame through the camera's lens. Without distortion: renderSupersampled().
+With it, in the ideal pinhole view of LensView (the pose, f' >= f, a margin around the frame),
+warped into the frame as Blender's Movie Distortion node does: the colour (and the virtual
+coverage) bilinearly, as a lens blurs; labels, depth and silhouettes by nearest sample from a
+view lensMaskFactor() times finer, so that they stay binary / one surface's depth and agree with
+each other pixel for pixel (a pixel's sample is within 0.5 / factor ideal pixels of its ray). */
+void renderView(GlScene& gl, const SceneModel& m, const Camera& cam, Size size, int supersample,
+                const std::vector<const detail::GlMesh*>& extra,
+                const std::vector<Vec3f>& extraCorners, const PassOutputs& out)
+{
+    if (!cam.hasDistortion())
+    {
+        renderSupersampled(gl, m, cam, size, supersample, extra, extraCorners, out);
+        return;
+    }
+    const Ptr<const LensView> view = LensView::get(cam, size);
+    const Camera ideal = view->idealCamera(cam);
+    const Size idealSize = view->idealSize();
+    if (out.bgr)
+    {
+        Mat bgr, cover;
+        PassOutputs colour;
+        colour.bgr = &bgr;
+        if (out.virtualCover)
+            colour.virtualCover = &cover;
+        renderSupersampled(gl, m, ideal, idealSize, supersample, extra, extraCorners, colour);
+        view->toFrame(bgr, *out.bgr, INTER_LINEAR);
+        if (out.virtualCover)
+            view->toFrame(cover, *out.virtualCover, INTER_LINEAR);
+    }
+    if (!out.labels && !out.depth && !out.whole)
+        return;
+    const int factor = lensMaskFactor(idealSize);
+    Mat labels, depth;
+    std::vector<Mat> whole;
+    PassOutputs rest;
+    rest.labels = out.labels ? &labels : nullptr;
+    rest.depth = out.depth ? &depth : nullptr;
+    rest.whole = out.whole ? &whole : nullptr;
+    renderPasses(gl, m, supersampledCamera(ideal, factor),
+                 Size(idealSize.width * factor, idealSize.height * factor), extra, extraCorners,
+                 rest);
+    const Mat& map = lensMaskMap(gl, view, factor);
+    if (out.labels)
+        cv::remap(labels, *out.labels, map, noArray(), INTER_NEAREST, BORDER_CONSTANT, Scalar());
+    if (out.depth)
+        cv::remap(depth, *out.depth, map, noArray(), INTER_NEAREST, BORDER_CONSTANT,
+                  Scalar::all(std::numeric_limits<double>::infinity()));
+    if (out.whole)
+    {
+        out.whole->resize(whole.size());
+        for (size_t i = 0; i < whole.size(); i++)
+            cv::remap(whole[i], (*out.whole)[i], map, noArray(), INTER_NEAREST, BORDER_CONSTANT,
+                      Scalar());
+    }
+}
+
+// Params::exposureDrift / whiteBalanceDrift on a rendered frame: BGR times `gains`, except for
+// the fraction `virtualCover` (optional) of each pixel, which keeps the nominal exposure.
+void applyGains(Mat& bgr, const Vec3d& gains, const Mat& virtualCover = Mat())
+{
+    if (gains == Vec3d(1, 1, 1))
+        return;  // no drift: the frame as rendered, bit for bit
+    parallel_for_(Range(0, bgr.rows), [&](const Range& r) {
+        for (int y = r.start; y < r.end; y++)
+        {
+            Vec3b* row = bgr.ptr<Vec3b>(y);
+            const float* cov = virtualCover.empty() ? nullptr : virtualCover.ptr<float>(y);
+            for (int x = 0; x < bgr.cols; x++)
+            {
+                const double c = cov ? cov[x] : 0.0;
+                for (int k = 0; k < 3; k++)
+                    row[x][k] = saturate_cast<uchar>(row[x][k] * (c + (1 - c) * gains[k]));
+            }
+        }
+    });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -940,9 +1146,63 @@ public:
         if (p.frameSupersample < 1 || p.frameSupersample > 8)
             CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: frameSupersample must be "
                      "in [1, 8] (got %d)", p.frameSupersample));
+        if (p.imageSize.width > std::max(kMaxImageWidth, kMaxImageHeight) ||
+            p.imageSize.height > std::max(kMaxImageWidth, kMaxImageHeight) ||
+            p.imageSize.width * (double)p.imageSize.height >
+                (double)kMaxImageWidth * kMaxImageHeight)
+            CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: imageSize must be at "
+                     "most %dx%d (or %dx%d) (got %dx%d)", kMaxImageWidth, kMaxImageHeight,
+                     kMaxImageHeight, kMaxImageWidth, p.imageSize.width, p.imageSize.height));
+        if (!p.distortion.empty())
+        {
+            if (p.model != PERSPECTIVE)
+                CV_Error(Error::StsBadArg, "SceneSynthesizer: distortion needs model "
+                         "PERSPECTIVE (a scaled orthographic camera has no lens)");
+            const size_t n = p.distortion.size();
+            bool finite = true;
+            for (double d : p.distortion)
+                finite = finite && std::isfinite(d);
+            if ((n != 4 && n != 5 && n != 8 && n != 12 && n != 14) || !finite)
+                CV_Error(Error::StsBadArg, cv::format("SceneSynthesizer: distortion must be 4, "
+                         "5, 8, 12 or 14 finite coefficients (got %d)", (int)n));
+        }
+        if (p.path != PATH_ORBIT && p.path != PATH_HANDHELD)
+            CV_Error(Error::StsBadArg, cv::format("SceneSynthesizer: path must be PATH_ORBIT or "
+                     "PATH_HANDHELD (got %d)", (int)p.path));
+        if (p.path == PATH_HANDHELD && p.model != PERSPECTIVE)
+            CV_Error(Error::StsBadArg, "SceneSynthesizer: path PATH_HANDHELD needs model "
+                     "PERSPECTIVE (a hand-held camera near the scene)");
+        if (!(std::abs(p.exposureDrift) < 1.0))
+            CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: exposureDrift must be "
+                     "in (-1, 1) (got %g)", p.exposureDrift));
+        if (!(std::abs(p.whiteBalanceDrift) < 1.0))
+            CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: whiteBalanceDrift must "
+                     "be in (-1, 1) (got %g)", p.whiteBalanceDrift));
+        if (!(p.videoBitrateMbps >= 0.0 && p.videoBitrateMbps <= 200.0))
+            CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: videoBitrateMbps must "
+                     "be in [0, 200] (got %g)", p.videoBitrateMbps));
+        if (p.videoBitrateMbps > 0 && (p.imageSize.width % 2 || p.imageSize.height % 2))
+            CV_Error(Error::StsBadArg, cv::format("SceneSynthesizer: videoBitrateMbps needs even "
+                     "imageSize sides (H.264 4:2:0; got %dx%d)", p.imageSize.width,
+                     p.imageSize.height));
+        std::shared_ptr<SceneModel> built;
+        if (!p.distortion.empty())
+        {
+            // A lens that folds over inside the frame has no ideal view: say so now, naming
+            // the parameter, rather than at the first render (the scene is needed for f).
+            built = buildScene(p);
+            try
+            {
+                LensView::get(built->cameras.front(), p.imageSize);
+            }
+            catch (const cv::Exception& e)
+            {
+                CV_Error(Error::StsBadArg, "SceneSynthesizer: distortion: " + e.err);
+            }
+        }
         std::lock_guard<std::mutex> lock(mutex_);
         p_ = p;
-        model_.reset();
+        model_ = built;
         gl_.reset();
     }
 
@@ -965,8 +1225,8 @@ public:
             out.labels = &scene.labels[f];
             out.depth = &scene.depth[f];
             out.whole = &whole[f];
-            renderSupersampled(gl, m, m.cameras[f], p_.imageSize, p_.frameSupersample, {}, {},
-                               out);
+            renderView(gl, m, m.cameras[f], p_.imageSize, p_.frameSupersample, {}, {}, out);
+            applyGains(scene.frames[f], frameGains(p_, f));
         }
         // Visible masks from the labels (CPU, parallel over frames: each writes its own masks).
         std::vector<std::vector<Mat>> visible(F, std::vector<Mat>(nObj));
@@ -1024,11 +1284,14 @@ public:
                 corners.push_back(Vec3f(c & 1 ? b[0] : a[0], c & 2 ? b[1] : a[1],
                                         c & 4 ? b[2] : a[2]));
         }
-        Mat bgr;
+        Mat bgr, cover;
         PassOutputs out;
         out.bgr = &bgr;
-        renderSupersampled(gl, m, m.cameras[frame], p_.imageSize, supersample, extra, corners,
-                           out);
+        const Vec3d gains = frameGains(p_, frame);
+        if (gains != Vec3d(1, 1, 1) && !extra.empty())
+            out.virtualCover = &cover;
+        renderView(gl, m, m.cameras[frame], p_.imageSize, supersample, extra, corners, out);
+        applyGains(bgr, gains, cover);
         meshes.clear();  // textures deleted while the context is current
         bgr.copyTo(image);
     }
@@ -1050,8 +1313,8 @@ public:
             out.depth = &dep;
         if (wholeMasks.needed())
             out.whole = &whole;
-        renderSupersampled(gl, m, m.cameras[frame], p_.imageSize, p_.frameSupersample, {}, {},
-                           out);
+        renderView(gl, m, m.cameras[frame], p_.imageSize, p_.frameSupersample, {}, {}, out);
+        applyGains(bgr, frameGains(p_, frame));
         bgr.copyTo(image);
         if (labels.needed())
             lab.copyTo(labels);
@@ -1116,6 +1379,21 @@ private:
 };
 
 } // namespace
+
+Vec3d SceneSynthesizer::frameGains(const Params& p, int frame)
+{
+    if (p.exposureDrift == 0 && p.whiteBalanceDrift == 0)
+        return Vec3d(1, 1, 1);
+    CV_CheckGE(frame, 0, "frameGains: frame");
+    CV_CheckLT(frame, p.frames, "frameGains: frame");
+    // A raised-cosine ramp over the shot: auto-exposure and white balance settle smoothly, with
+    // no jump in rate at the ends.
+    const double t = p.frames > 1 ? (double)frame / (p.frames - 1) : 0.0;
+    const double w = 0.5 * (1 - std::cos(kPi * t));
+    const double gain = 1 + p.exposureDrift * w;
+    const double wb = p.whiteBalanceDrift * w;
+    return Vec3d(gain * (1 - wb), gain, gain * (1 + wb));
+}
 
 Ptr<SceneSynthesizer> SceneSynthesizer::create(const Params& params)
 {

@@ -8,9 +8,18 @@
 
 #include "atomic_write.hpp"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+
+extern char** environ;  // POSIX: the environment handed to ffmpeg
 
 namespace cv {
 namespace augocc {
@@ -46,6 +55,76 @@ void writeVideo(const String& path, const std::vector<Mat>& frames)
         writer.write(f);
     writer.release();
     detail::checkVideoFile(path, (int)frames.size(), path);
+}
+
+/* video.mp4 at a set bit rate: H.264 by libx264 through the `ffmpeg` tool (Debian's ffmpeg,
+installed by scripts/setup.sh), reading the frames/%04d.png just written. OpenCV 4.6's
+VideoWriter cannot set a bit rate: its FFmpeg backend fixes the rate from the frame size and
+ignores VIDEOWRITER_PROP_QUALITY for H.264; the only other door, the process-wide environment
+variable OPENCV_FFMPEG_WRITER_OPTIONS, is not thread-safe to set from a library. libavcodec
+directly would be ~200 lines of encoder plumbing for one synthetic-data option; the tool is one
+process with a documented command line. Rate control as a phone's encoder: average rate R with
+a VBV of maxrate R and a buffer of 2 R (near-constant bit rate), 4:2:0, High profile. */
+void writeVideoAtBitrate(const fs::path& framesDir, const String& path, int frames, double mbps)
+{
+    detail::checkCreatable(path, path);
+    const std::string rate = format("%.0fk", mbps * 1000);
+    const std::string buf = format("%.0fk", 2 * mbps * 1000);
+    std::vector<std::string> args = {
+        "ffmpeg", "-hide_banner", "-nostdin", "-loglevel", "error", "-y",
+        "-framerate", format("%g", kVideoFps), "-start_number", "0",
+        "-i", (framesDir / "%04d.png").string(), "-frames:v", std::to_string(frames),
+        "-c:v", "libx264", "-preset", "medium", "-profile:v", "high", "-pix_fmt", "yuv420p",
+        "-b:v", rate, "-maxrate", rate, "-bufsize", buf, "-movflags", "+faststart", path};
+    std::vector<char*> argv;
+    for (std::string& a : args)
+        argv.push_back(&a[0]);
+    argv.push_back(nullptr);
+    // ffmpeg's stderr goes to a log beside the video, read back on failure.
+    const std::string logPath = path + ".log";
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 2, logPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+    pid_t pid = 0;
+    const int rc = posix_spawnp(&pid, "ffmpeg", &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0)
+    {
+        std::remove(logPath.c_str());
+        CV_Error(Error::StsError, path + ": cannot run the ffmpeg tool for the H.264 bit rate "
+                 "(videoBitrateMbps): " + std::string(strerror(rc)) + "; scripts/setup.sh "
+                 "installs it (Debian package ffmpeg)");
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+    {
+    }
+    std::ifstream logFile(logPath);
+    std::stringstream log;
+    log << logFile.rdbuf();
+    logFile.close();
+    std::remove(logPath.c_str());
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        CV_Error(Error::StsError, path + ": ffmpeg (libx264 at " + rate + "bit/s) failed: " +
+                 log.str());
+    detail::checkVideoFile(path, frames, path);
+}
+
+// calibration.yml: the true intrinsics in OpenCV's calibration format (CONTRACT.md), as a
+// calibrateCamera user writes them; no lens = five zero coefficients, as calibrateCamera writes.
+void writeCalibration(const String& path, const Camera& cam, Size size)
+{
+    detail::writeStorageFile(path, [&](FileStorage& fs) {
+        fs << "image_width" << size.width;
+        fs << "image_height" << size.height;
+        fs << "camera_matrix" << Mat(cam.K);
+        std::vector<double> d = cam.distortion;
+        if (d.empty())
+            d.assign(5, 0.0);
+        fs << "distortion_coefficients" << Mat(d).reshape(1, 1);
+    }, path);
 }
 
 // Depth as 16-bit PNG: value = round(z * scale), 0 where nothing; scale a power of ten chosen so
@@ -120,7 +199,14 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
                 if (progress)
                     progress(end, F);
             }
-            writeVideo((tmp / "video.mp4").string(), scene.frames);
+            if (p.videoBitrateMbps > 0)
+                writeVideoAtBitrate(tmp / "frames", (tmp / "video.mp4").string(), F,
+                                    p.videoBitrateMbps);
+            else
+                writeVideo((tmp / "video.mp4").string(), scene.frames);
+            if (scene.groundTruth.model == PERSPECTIVE && !scene.groundTruth.cameras.empty())
+                writeCalibration((tmp / "calibration.yml").string(),
+                                 scene.groundTruth.cameras.front(), scene.groundTruth.imageSize);
             fs::create_directories(tmp / "input");
             fs::create_directories(tmp / "gt");
             writeMasks((tmp / "input" / "masks").string(), scene.keyFrameMasks);
@@ -146,6 +232,15 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
                 info << "frame_supersample" << p.frameSupersample;
                 info << "orbit_degrees" << p.orbitDegrees;
                 info << "elevation_degrees" << p.elevationDegrees;
+                info << "path" << (p.path == SceneSynthesizer::PATH_HANDHELD ? "handheld"
+                                                                              : "orbit");
+                info << "distortion" << "[:";
+                for (double d : p.distortion)
+                    info << d;
+                info << "]";
+                info << "exposure_drift" << p.exposureDrift;
+                info << "white_balance_drift" << p.whiteBalanceDrift;
+                info << "video_bitrate_mbps" << p.videoBitrateMbps;
                 info << "objects" << "[";
                 for (const String& name : scene.objectNames)
                     info << name;

@@ -127,10 +127,33 @@ struct CV_EXPORTS DemoOptions
     //! Camera distance over the scene size (SceneSynthesizer::Params::distanceRatio; small values
     //! give strong perspective, as hand-held footage near a building).
     double distanceRatio = SceneSynthesizer::Params().distanceRatio;
+    //! Camera path (SceneSynthesizer::Params::path).
+    SceneSynthesizer::CameraPath path = SceneSynthesizer::Params().path;
+    //! Azimuth swept by the camera, degrees (SceneSynthesizer::Params::orbitDegrees).
+    double orbitDegrees = SceneSynthesizer::Params().orbitDegrees;
+    //! Key frames given masks (SceneSynthesizer::Params::numKeyFrames).
+    int numKeyFrames = SceneSynthesizer::Params().numKeyFrames;
+    /** The lens of the synthesized footage (SceneSynthesizer::Params::distortion). The demo
+    writes the true intrinsics to DemoResult::calibrationPath; the pipeline run does not read
+    them (it recovers the cameras from the footage alone). */
+    std::vector<double> distortion = SceneSynthesizer::Params().distortion;
+    //! SceneSynthesizer::Params::exposureDrift.
+    double exposureDrift = SceneSynthesizer::Params().exposureDrift;
+    //! SceneSynthesizer::Params::whiteBalanceDrift.
+    double whiteBalanceDrift = SceneSynthesizer::Params().whiteBalanceDrift;
+    /** Bit rate of the footage, Mbit/s (SceneSynthesizer::Params::videoBitrateMbps). When set,
+    the pipeline runs on that H.264 video, as a user's footage; 0: on lossless PNG frames. */
+    double videoBitrateMbps = SceneSynthesizer::Params().videoBitrateMbps;
     bool photoRefine = true;  //!< RunOptions::photoRefine
     //! Stage progress: (stage name, done, total), as RunOptions::progress.
     std::function<void(const String& stage, int done, int total)> progress;
 };
+
+/** @brief The hand-held demo (`augocc demo --model handheld`): street-level hand-held 1280x720
+footage through a lens with k1 = -0.12, the camera 1.5 scene sizes away walking 30 degrees past
+the scene, 90 frames, 6 key frames, exposure drift 0.15, white-balance drift 0.05, H.264 at 8
+Mbit/s (a phone's rate at 720p). */
+CV_EXPORTS DemoOptions handheldDemoOptions();
 
 //! What runDemo() produced and measured.
 struct CV_EXPORTS DemoResult
@@ -143,6 +166,9 @@ struct CV_EXPORTS DemoResult
     double boundaryDistance = 0; //!< occlusion boundary, px: mean over the boundaryFrames
     int boundaryFrames = 0;      //!< frames where the truth or the composite has one
     double rotationErrorDeg = 0; //!< mean camera rotation error after alignment
+    //! The true intrinsics (OpenCV's calibration.yml) of PERSPECTIVE footage written as a data
+    //! set (DemoOptions::videoBitrateMbps > 0); else empty.
+    String calibrationPath;
 };
 
 /** @brief The embedded demo: synthesizes a scene, writes its video and key-frame masks, a

@@ -103,12 +103,48 @@ current on the calling thread.
 class CV_EXPORTS SceneSynthesizer : public Algorithm
 {
 public:
+    //! Camera paths of Params::path.
+    enum CameraPath
+    {
+        /** The orbit described above the class: far away, azimuth swept over orbitDegrees at
+        elevationDegrees, about 1 degree of jitter. */
+        PATH_ORBIT = 0,
+        /** Street-level hand-held: a walker at D = distanceRatio * scene size from the scene
+        centre (horizontally, +-kHandheldSwayUnits) sweeping orbitDegrees of azimuth past the
+        scene, the camera at kHandheldHeightFraction of the tallest object's height above the
+        ground (about 1.6 units: the front building is 3.2 units tall, two storeys, so about 3 m)
+        with smooth sway of the hand (+-kHandheldSwayUnits per axis), aim wobble (yaw and pitch,
+        +-kHandheldWobbleDeg) and roll (+-kHandheldRollDeg) around the line of sight to the
+        scene centre. Every motion is a sum of three sinusoids of 0.6-3.2 cycles per shot with
+        phases from the seed (elevationDegrees is not used). */
+        PATH_HANDHELD = 1
+    };
+    //! Largest frame size: UHD 3840 x 2160 (or 2160 x 3840).
+    static const int kMaxImageWidth = 3840;
+    //! Largest frame size: the other side.
+    static const int kMaxImageHeight = 2160;
+    //! PATH_HANDHELD: camera height over the tallest object's height.
+    static constexpr double kHandheldHeightFraction = 0.25;
+    //! PATH_HANDHELD: peak sway of the camera centre per axis, world units.
+    static constexpr double kHandheldSwayUnits = 0.12;
+    //! PATH_HANDHELD: peak aim wobble (yaw, pitch), degrees.
+    static constexpr double kHandheldWobbleDeg = 1.5;
+    //! PATH_HANDHELD: peak roll, degrees.
+    static constexpr double kHandheldRollDeg = 1.5;
+    //! Lens distortion: the finest sampling of labels, depth and masks (see Params::distortion).
+    static const int kLensMaskSupersample = 2;
+    //! Lens distortion: at most this many samples per label / depth / mask render.
+    static const int kLensMaskPixels = 12 * 1000 * 1000;
+
     /** @brief Parameters of the synthesized scene; the defaults are the initializers.
 
     Valid ranges (setParams() throws StsBadArg/StsOutOfRange otherwise): frames >= 2, both image
     sides >= 32, distanceRatio >= 1, orbitDegrees in [0, 360], elevationDegrees in (0, 90),
     numTracks >= 1, noiseSigma >= 0, both fractions in [0, 1], numKeyFrames in [2, frames],
-    frameSupersample in [1, 8]. */
+    frameSupersample in [1, 8], both image sides within kMaxImageWidth x kMaxImageHeight (either
+    orientation), distortion empty or 4, 5, 8, 12 or 14 finite values with model PERSPECTIVE
+    (and no fold-over inside the frame, see LensView::get()), path HANDHELD with model
+    PERSPECTIVE, |exposureDrift| and |whiteBalanceDrift| < 1, videoBitrateMbps in [0, 200]. */
     struct CV_EXPORTS Params
     {
         //! Number of frames.
@@ -140,7 +176,34 @@ public:
         like a camera integrating over each pixel; masks, labels and depth are always sampled at
         pixel centres. 1 = one sample per pixel (hard, aliased edges). */
         int frameSupersample = 1;
+        /** Lens distortion of the true cameras (OpenCV's k1, k2, p1, p2[, k3 ...], exactly
+        cv::projectPoints' model), PERSPECTIVE only; empty = an ideal pinhole (today's frames).
+        Frames, labels, depth and masks are rendered in the ideal pinhole view of LensView and
+        warped into the distorted frame: colours bilinearly; labels, depth and masks from a
+        view rendered kLensMaskSupersample times finer (fewer for large frames: at most
+        kLensMaskPixels samples) by nearest sample, i.e. a frame pixel's mask is the object its
+        ray through a point within 0.5 / factor ideal pixels of its centre hits. */
+        std::vector<double> distortion;
+        //! Camera path (see CameraPath).
+        CameraPath path = PATH_ORBIT;
+        /** Auto-exposure drift: the frames' gain moves smoothly (a raised-cosine ramp) from 1 at
+        the first frame to 1 + exposureDrift at the last, multiplying the rendered BGR values
+        (saturated to 255). Frames only: masks, depth, labels and cameras are unchanged. */
+        double exposureDrift = 0.0;
+        /** White-balance change over the shot on the same ramp: red gain 1 + w, blue gain
+        1 - w, green 1, with w going from 0 to whiteBalanceDrift (positive: warmer). */
+        double whiteBalanceDrift = 0.0;
+        /** writeSyntheticScene(): bit rate of video.mp4, Mbit/s (H.264, libx264 through the
+        `ffmpeg` tool, a phone's 8-16 Mbit/s at 1080p); 0 = OpenCV's VideoWriter with its own
+        rate (H.264, else MPEG-4 part 2). */
+        double videoBitrateMbps = 0.0;
     };
+
+    /** @brief The per-frame gains of Params::exposureDrift and Params::whiteBalanceDrift.
+    @param params the parameters.
+    @param frame frame index in [0, frames).
+    @return (blue, green, red) gains multiplying the rendered frame. */
+    static Vec3d frameGains(const Params& params, int frame);
 
     //! Creates a synthesizer; throws as setParams() does on invalid parameters.
     //! @param params scene parameters.
@@ -156,7 +219,11 @@ public:
     virtual void synthesize(SyntheticScene& scene) const = 0;
 
     /** @brief Renders one frame of the sequence with virtual objects inserted using the true
-    geometry (the compositor's ground truth).
+    geometry (the compositor's ground truth). Through the lens when the cameras have one (the
+    distorted frame). With exposure or white-balance drift (Params) the real scene's pixels
+    carry the frame's gains and the virtual objects' do not: the truth is what a compositor that
+    draws the virtual objects at the nominal exposure onto the filmed frame produces (augocc's
+    compositor does not model the camera's exposure); edge pixels blend the two by coverage.
     @param frame frame index.
     @param virtualObjects meshes in world coordinates.
     @param image output BGR CV_8UC3.
@@ -188,7 +255,9 @@ public:
 };
 
 /** @brief Writes a synthesized data set to a folder, as `augocc synth` does: frames/%04d.png,
-video.mp4 (H.264, else MPEG-4 part 2), tracks.yml, input/masks (key frames), gt/masks (whole),
+video.mp4 (H.264, else MPEG-4 part 2; at Params::videoBitrateMbps when set), calibration.yml
+(the true intrinsics as OpenCV's calibration file: camera_matrix, distortion_coefficients,
+image_width, image_height; PERSPECTIVE only), tracks.yml, input/masks (key frames), gt/masks (whole),
 gt/visible_masks, gt/reconstruction.yml, gt/clean_tracks.yml, gt/depth (16-bit PNG, z = value /
 scale, scale in gt/depth/depth.yml, 0 = nothing), gt/labels, `gt/meshes/<object>.ply` and
 gt/synth.yml (parameters, objects, key frames, outlier flags). See doc/synthesizer.md.
