@@ -20,6 +20,7 @@ void registerDemo(CLI::App& app, Globals& g)
     auto noPhoto = std::make_shared<bool>(false);
     auto model = std::make_shared<std::string>("scaled_orthographic");
     auto distance = std::make_shared<double>(DemoOptions().distanceRatio);
+    auto lens = std::make_shared<std::string>("self");
     CLI::App* sub = app.add_subcommand("demo", "synthesize a scene and run the whole pipeline "
                                        "on it (no input needed)");
     sub->add_option("--out-dir", *outDir, "output folder (default augocc_demo)");
@@ -31,7 +32,10 @@ void registerDemo(CLI::App& app, Globals& g)
                     "white-balance drift, H.264 at 8 Mbit/s)");
     CLI::Option* distanceOpt = sub->add_option("--distance-ratio", *distance, "camera distance over the scene size (default "
                     "10; 3 is hand-held footage near the buildings, strong perspective)");
-    sub->callback([&g, outDir, noPhoto, model, distance, distanceOpt]() {
+    sub->add_option("--lens", *lens, "how the run learns the lens: self (from the footage, "
+                    "default), calibration (the synthesized calibration.yml, as augocc run "
+                    "--calibration; handheld only), ignored (no lens model, for comparison)");
+    sub->callback([&g, outDir, noPhoto, model, distance, distanceOpt, lens]() {
         const bool handheld = *model == "handheld";
         DemoOptions o = handheld ? handheldDemoOptions() : DemoOptions();
         if (*model != "scaled_orthographic" && *model != "perspective" && !handheld)
@@ -46,6 +50,15 @@ void registerDemo(CLI::App& app, Globals& g)
         }
         else if (distanceOpt->count() > 0)
             o.distanceRatio = *distance;
+        if (*lens == "self")
+            o.lens = DEMO_LENS_SELF_CALIBRATE;
+        else if (*lens == "calibration" && handheld)
+            o.lens = DEMO_LENS_CALIBRATION;
+        else if (*lens == "ignored")
+            o.lens = DEMO_LENS_IGNORED;
+        else
+            throw UsageError("--lens " + *lens + ": expected self, calibration (with --model "
+                             "handheld) or ignored");
         o.outDir = *outDir;
         o.photoRefine = !*noPhoto;
         std::shared_ptr<Progress> current;
@@ -60,12 +73,19 @@ void registerDemo(CLI::App& app, Globals& g)
         info(g, "contact sheet: " + r.contactSheetPath);
         info(g, "scene file:    " + r.scenePath);
         if (!r.calibrationPath.empty())
-            info(g, "calibration:   " + r.calibrationPath + " (true intrinsics; not used by "
-                 "this run)");
+            info(g, "calibration:   " + r.calibrationPath + (o.lens == DEMO_LENS_CALIBRATION ?
+                 " (true intrinsics, given to the run)" : " (true intrinsics; not used by this "
+                 "run)"));
+        info(g, "lens:          " + r.run.sfm.lensReason);
         info(g, cv::format("accuracy against the synthetic ground truth: %.2f%% of pixels within "
                            "8 grey levels, occlusion boundary %.2f px (mean over the %d frames "
                            "with one), camera rotation error %.3f deg", 100 * r.fractionWithin,
                            r.boundaryDistance, r.boundaryFrames, r.rotationErrorDeg));
+        info(g, cv::format("slide of a virtual point against the real scene: median %.2f px, "
+                           "95th percentile %.2f px, worst %.2f px; focal length %.2f%% off; "
+                           "mattes: key frames IoU >= %.4f, non-key mean IoU %.4f",
+                           r.slide.median, r.slide.p95, r.slide.max, r.focalErrorPercent,
+                           r.keyFrameIoU, r.nonKeyIoU));
     });
 }
 

@@ -313,6 +313,7 @@ RunResult runPipeline(const RunOptions& o)
         sfm.calibration = readCalibration(o.calibrationPath, src->size());
     sfm.focal = o.focal;
     sfm.refineIntrinsics = o.refineIntrinsics;
+    sfm.selfCalibrate = o.selfCalibrate;
     // An output folder made here and still empty when a stage fails goes again. Intermediate
     // files already written stay: each is complete (written atomically) and re-runs by hand.
     struct EmptyDirGuard
@@ -514,6 +515,14 @@ DemoResult runDemo(const DemoOptions& o)
     ro.outDir = o.outDir;
     ro.progress = o.progress;
     ro.photoRefine = o.photoRefine;
+    if (o.lens == DEMO_LENS_CALIBRATION)
+    {
+        if (res.calibrationPath.empty())
+            CV_Error(Error::StsBadArg, "runDemo: DEMO_LENS_CALIBRATION needs perspective footage "
+                     "written as a data set (videoBitrateMbps > 0)");
+        ro.calibrationPath = res.calibrationPath;
+    }
+    ro.selfCalibrate = o.lens != DEMO_LENS_IGNORED;
     res.run = runPipeline(ro);
     res.compositePath = res.run.compositePath;
 
@@ -571,6 +580,43 @@ DemoResult runDemo(const DemoOptions& o)
         }
     }
     CV_Assert(scored > 0);
+    res.slide = measureSlide(rec, scene.groundTruth);
+    if (rec.model == PERSPECTIVE && !rec.cameras.empty())
+        res.focalErrorPercent = 100 * std::abs(rec.cameras[0].K(0, 0) /
+                                               scene.groundTruth.camera(rec.cameras[0].frame).K(0, 0) - 1);
+    {
+        // Mattes in the frames against the truth.
+        ObjectMasks mattes;
+        renderMattes(*res.run.clones, rec, mattes);
+        double sum = 0;
+        int cnt = 0;
+        for (const auto& o : mattes)
+        {
+            const auto vis = scene.visibleMasks.find(o.first);
+            if (vis == scene.visibleMasks.end())
+                continue;
+            const std::vector<int>& keys = scene.keyFrames;
+            for (const auto& fm : o.second)
+            {
+                const int f = fm.first;
+                Mat others(fm.second.size(), CV_8U, Scalar(0));
+                for (const auto& v : scene.visibleMasks)
+                    if (v.first != o.first)
+                        others |= v.second.at(f);
+                const Mat m = fm.second & ~others, t = vis->second.at(f) & ~others;
+                const double uni = countNonZero(m | t);
+                const double iou = uni > 0 ? countNonZero(m & t) / uni : 1.0;
+                if (std::find(keys.begin(), keys.end(), f) != keys.end())
+                    res.keyFrameIoU = std::min(res.keyFrameIoU, iou);
+                else
+                {
+                    sum += iou;
+                    cnt++;
+                }
+            }
+        }
+        res.nonKeyIoU = cnt > 0 ? sum / cnt : 1.0;
+    }
     res.fractionWithin /= scored;
     res.boundaryDistance /= std::max(1, res.boundaryFrames);
     res.rotationErrorDeg /= scored;

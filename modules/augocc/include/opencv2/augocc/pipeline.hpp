@@ -10,6 +10,7 @@
 #include "opencv2/augocc/camera_refiner.hpp"
 #include "opencv2/augocc/clone_builder.hpp"
 #include "opencv2/augocc/compositor.hpp"
+#include "opencv2/augocc/evaluation.hpp"
 #include "opencv2/augocc/io.hpp"
 #include "opencv2/augocc/mesh.hpp"
 #include "opencv2/augocc/scene_synthesizer.hpp"
@@ -94,6 +95,8 @@ struct CV_EXPORTS RunOptions
     String calibrationPath;
     double focal = 0;               //!< known focal only, pixels (SfmOptions::focal); 0: none
     bool refineIntrinsics = false;  //!< SfmOptions::refineIntrinsics
+    //! SfmOptions::selfCalibrate: false ignores lens distortion when nothing is known.
+    bool selfCalibrate = true;
     //! Stage progress: (stage name, done, total); a stage starts with done = 0.
     std::function<void(const String& stage, int done, int total)> progress;
 };
@@ -113,6 +116,14 @@ struct CV_EXPORTS RunResult
 /** @brief track -> sfm -> clone -> matte -> composite, writing into outDir: tracks.yml,
 reconstruction.yml, clones.yml.gz, mattes/, composite.mp4 (contract). Throws as the stages do. */
 CV_EXPORTS RunResult runPipeline(const RunOptions& options);
+
+//! DemoOptions::lens.
+enum DemoLens
+{
+    DEMO_LENS_SELF_CALIBRATE = 0,  //!< the lens from the footage (SfmOptions::selfCalibrate)
+    DEMO_LENS_CALIBRATION = 1,     //!< the synthesized calibration.yml given to the run
+    DEMO_LENS_IGNORED = 2          //!< no lens model
+};
 
 //! Options of runDemo() (`augocc demo`).
 struct CV_EXPORTS DemoOptions
@@ -144,6 +155,11 @@ struct CV_EXPORTS DemoOptions
     /** Bit rate of the footage, Mbit/s (SceneSynthesizer::Params::videoBitrateMbps). When set,
     the pipeline runs on that H.264 video, as a user's footage; 0: on lossless PNG frames. */
     double videoBitrateMbps = SceneSynthesizer::Params().videoBitrateMbps;
+    /** How the run learns the lens: DEMO_LENS_SELF_CALIBRATE (from the footage alone, the
+    default), DEMO_LENS_CALIBRATION (`augocc run --calibration` with the synthesized
+    calibration.yml; needs videoBitrateMbps > 0, which writes it), DEMO_LENS_IGNORED (no lens
+    model: what augocc did before issue 15, for comparison). */
+    int lens = DEMO_LENS_SELF_CALIBRATE;
     bool photoRefine = true;  //!< RunOptions::photoRefine
     //! Stage progress: (stage name, done, total), as RunOptions::progress.
     std::function<void(const String& stage, int done, int total)> progress;
@@ -166,6 +182,14 @@ struct CV_EXPORTS DemoResult
     double boundaryDistance = 0; //!< occlusion boundary, px: mean over the boundaryFrames
     int boundaryFrames = 0;      //!< frames where the truth or the composite has one
     double rotationErrorDeg = 0; //!< mean camera rotation error after alignment
+    //! measureSlide() of the recovered cameras against the true ones (with their lens)
+    SlideStats slide;
+    //! PERSPECTIVE: |f_recovered / f_true - 1| of the first camera, percent
+    double focalErrorPercent = 0;
+    /** Mattes against the true visible silhouettes, outside the pixels where another object is
+    seen (there the clone is behind it, by design): the lowest IoU over the objects' key frames,
+    and the mean over every object's non-key frames. */
+    double keyFrameIoU = 1, nonKeyIoU = 0;
     //! The true intrinsics (OpenCV's calibration.yml) of PERSPECTIVE footage written as a data
     //! set (DemoOptions::videoBitrateMbps > 0); else empty.
     String calibrationPath;
