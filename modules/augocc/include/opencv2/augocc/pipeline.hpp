@@ -189,7 +189,8 @@ struct CV_EXPORTS DemoResult
     /** Mattes against the true visible silhouettes, outside the pixels where another object is
     seen (there the clone is behind it, by design): the lowest IoU over the objects' key frames,
     and the mean over every object's non-key frames. */
-    double keyFrameIoU = 1, nonKeyIoU = 0;
+    double keyFrameIoU = 1;
+    double nonKeyIoU = 0;  //!< see keyFrameIoU
     //! The true intrinsics (OpenCV's calibration.yml) of PERSPECTIVE footage written as a data
     //! set (DemoOptions::videoBitrateMbps > 0); else empty.
     String calibrationPath;
