@@ -1093,7 +1093,20 @@ void selfCalibrate(const Tracks& tracks, const SfmOptions& options, Reconstructi
     Reconstruction best = models[bestModel];
     adjustLens(tracks, best, bestModel == 1 ? free1 : free2, options.refiner, &relStd, false);
     rep.focalRelStd = relStd;
-    if (!(relStd >= 0) || relStd > options.maxFocalRelStd)
+    // ceres::Covariance's SPARSE_QR refuses a Jacobian it finds rank-deficient; with the scale
+    // gauge free that decision is borderline and varied between runs of the same footage
+    // (2026-12-02: 0.0066 in one run, refused in the next). A refused computation is no evidence
+    // that the focal is undetermined: the BIC choice stands and the reason says so. (Far-away
+    // footage is caught before, by the orthographic model choice.)
+    if (!(relStd >= 0))
+    {
+        rec = models[bestModel];
+        rep.lensModel = names[bestModel];
+        rep.lensReason = "self-calibrated; the focal's standard deviation could not be computed "
+                         "(rank-deficient Jacobian), the BIC choice is kept; " + bicText;
+        return;
+    }
+    if (relStd > options.maxFocalRelStd)
     {
         rep.lensReason = cv::format("the focal length is not determined (relative standard "
                                     "deviation %.3g > %.3g: too little depth variation or "
