@@ -21,21 +21,6 @@ struct LensScene
     Reconstruction pinholeRec; // the same cameras without their lens
 };
 
-// Pinhole hull of one box in ideal pixels of `cam` (pinhole).
-std::vector<Point2f> boxHull(const std::pair<Vec3d, Vec3d>& b, const Camera& pin)
-{
-    std::vector<Point2f> c, hull;
-    for (int q = 0; q < 8; q++)
-    {
-        const Vec3d X(q & 1 ? b.second[0] : b.first[0], q & 2 ? b.second[1] : b.first[1],
-                      q & 4 ? b.second[2] : b.first[2]);
-        const Point2d uv = pin.project(X);
-        c.push_back(Point2f((float)uv.x, (float)uv.y));
-    }
-    convexHull(c, hull);
-    return hull;
-}
-
 // Silhouette in the distorted frame: pixel centre p is in when its ray (the ideal view's pixel
 // LensView::frameMap() gives, exact to 0.005 px; test_lens.cpp checks it) is inside the pinhole
 // silhouette.

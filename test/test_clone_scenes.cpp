@@ -25,20 +25,26 @@ Camera orbitCamera(CameraModel model, double azimuthDeg, double elevationDeg, do
     return Camera::perspective(R, t, Matx33d(fpx, 0, pp.x, 0, fpx, pp.y, 0, 0, 1), frame);
 }
 
+std::vector<Point2f> boxHull(const std::pair<Vec3d, Vec3d>& b, const Camera& cam)
+{
+    std::vector<Point2f> c, hull;
+    for (int q = 0; q < 8; q++)
+    {
+        const Vec3d X(q & 1 ? b.second[0] : b.first[0], q & 2 ? b.second[1] : b.first[1],
+                      q & 4 ? b.second[2] : b.first[2]);
+        const Point2d uv = cam.project(X);
+        c.push_back(Point2f((float)uv.x, (float)uv.y));
+    }
+    convexHull(c, hull);
+    return hull;
+}
+
 Mat silhouetteOf(const AnalyticObject& o, const Camera& cam, Size size)
 {
     Mat m(size, CV_8U, Scalar(0));
     for (const auto& b : o.boxes)
     {
-        std::vector<Point2f> c, hull;
-        for (int q = 0; q < 8; q++)
-        {
-            const Vec3d X(q & 1 ? b.second[0] : b.first[0], q & 2 ? b.second[1] : b.first[1],
-                          q & 4 ? b.second[2] : b.first[2]);
-            const Point2d uv = cam.project(X);
-            c.push_back(Point2f((float)uv.x, (float)uv.y));
-        }
-        convexHull(c, hull);
+        const std::vector<Point2f> hull = boxHull(b, cam);
         const Rect r = boundingRect(hull) & Rect(Point(0, 0), size);
         for (int y = r.y; y < r.y + r.height; y++)
             for (int x = r.x; x < r.x + r.width; x++)

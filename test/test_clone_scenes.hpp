@@ -37,6 +37,8 @@ struct AnalyticScene
 Camera orbitCamera(CameraModel model, double azimuthDeg, double elevationDeg, double dist,
                    const Vec3d& target, Size size, double pixelsPerUnit, int frame);
 
+// Convex hull of a box's projected corners (a pinhole camera: the exact silhouette).
+std::vector<Point2f> boxHull(const std::pair<Vec3d, Vec3d>& box, const Camera& cam);
 Mat silhouetteOf(const AnalyticObject& o, const Camera& cam, Size size);
 
 AnalyticScene makeScene(CameraModel model, const std::vector<AnalyticObject>& objects, int frames,

@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "precomp.hpp"
+#include "pinhole.hpp"
 
 namespace cv {
 namespace augocc {
@@ -169,20 +170,14 @@ Point2d Camera::undistortPixel(const Point2d& px) const
 {
     if (!hasDistortion())
         return px;
-    const double yd = (px.y - K(1, 2)) / K(1, 1);
-    const double xd = (px.x - K(0, 2) - K(0, 1) * yd) / K(0, 0);
-    const Point2d n = undistortNormalized(Point2d(xd, yd));
-    return Point2d(K(0, 0) * n.x + K(0, 1) * n.y + K(0, 2), K(1, 1) * n.y + K(1, 2));
+    return detail::pixelOf(K, undistortNormalized(detail::normalizedOf(K, px)));
 }
 
 Point2d Camera::distortPixel(const Point2d& px) const
 {
     if (!hasDistortion())
         return px;
-    const double y = (px.y - K(1, 2)) / K(1, 1);
-    const double x = (px.x - K(0, 2) - K(0, 1) * y) / K(0, 0);
-    const Point2d d = distortNormalized(Point2d(x, y));
-    return Point2d(K(0, 0) * d.x + K(0, 1) * d.y + K(0, 2), K(1, 1) * d.y + K(1, 2));
+    return detail::pixelOf(K, distortNormalized(detail::normalizedOf(K, px)));
 }
 
 Camera Camera::pinhole() const

@@ -12,6 +12,7 @@
 
 #include "precomp.hpp"
 #include "gl_context.hpp"
+#include "pinhole.hpp"
 #include "shading.hpp"
 
 #include <functional>
@@ -307,9 +308,8 @@ public:
                                 for (int x = 0; x < gsz.width; x++)
                                 {
                                     const Vec3d n = Hi * Vec3d(x, y, 1);
-                                    const Point2d p = occCam.distortPixel(Point2d(
-                                        occCam.K(0, 0) * n[0] + occCam.K(0, 1) * n[1] + occCam.K(0, 2),
-                                        occCam.K(1, 1) * n[1] + occCam.K(1, 2)));
+                                    const Point2d p = detail::pixelOf(occCam.K,
+                                        occCam.distortNormalized(Point2d(n[0], n[1])));
                                     row[x] = Vec2f((float)p.x, (float)p.y);
                                 }
                             }

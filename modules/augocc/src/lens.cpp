@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "precomp.hpp"
+#include "pinhole.hpp"
 
 #include <list>
 #include <mutex>
@@ -20,16 +21,8 @@ const int kGridStep = 4;
 const double kMaxGrowth = 3.0;
 const double kMarginPx = 2.0;
 
-Point2d normalizedOf(const Matx33d& K, const Point2d& px)
-{
-    const double y = (px.y - K(1, 2)) / K(1, 1);
-    return Point2d((px.x - K(0, 2) - K(0, 1) * y) / K(0, 0), y);
-}
-
-Point2d pixelOf(const Matx33d& K, const Point2d& n)
-{
-    return Point2d(K(0, 0) * n.x + K(0, 1) * n.y + K(0, 2), K(1, 1) * n.y + K(1, 2));
-}
+using detail::normalizedOf;
+using detail::pixelOf;
 
 // Samples of the frame's border (pixel edges) and interior for the view's bounds and density.
 std::vector<Point2d> borderSamples(Size size)
@@ -233,33 +226,6 @@ Ptr<const LensView> LensView::get(const Camera& camera, Size frameSize)
     if (cache.size() > kCapacity)
         cache.pop_back();
     return view;
-}
-
-void renderThroughLens(const Camera& camera, Size frameSize,
-                       const std::function<void(const Camera&, Size, std::vector<Mat>&)>& render,
-                       std::vector<Mat>& outputs, const std::vector<int>& interpolations,
-                       const std::vector<Scalar>& borders)
-{
-    if (!camera.hasDistortion())
-    {
-        render(camera, frameSize, outputs);
-        return;
-    }
-    Ptr<const LensView> view = LensView::get(camera, frameSize);
-    std::vector<Mat> ideal;
-    render(view->idealCamera(camera), view->idealSize(), ideal);
-    outputs.resize(ideal.size());
-    for (size_t i = 0; i < ideal.size(); i++)
-    {
-        if (ideal[i].empty())
-        {
-            outputs[i].release();
-            continue;
-        }
-        const int interp = i < interpolations.size() ? interpolations[i] : (int)INTER_LINEAR;
-        const Scalar border = i < borders.size() ? borders[i] : Scalar();
-        view->toFrame(ideal[i], outputs[i], interp, border);
-    }
 }
 
 } // namespace augocc

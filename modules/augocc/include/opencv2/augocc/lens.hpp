@@ -4,8 +4,6 @@
 #ifndef OPENCV_AUGOCC_LENS_HPP
 #define OPENCV_AUGOCC_LENS_HPP
 
-#include <functional>
-#include <vector>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include "opencv2/augocc/camera.hpp"
@@ -87,24 +85,6 @@ private:
     Mat toIdealMap_;       // idealSize, CV_32FC2: the frame pixel each ideal pixel sees
     Mat toFrameMap_;       // frameSize, CV_32FC2: the ideal pixel each frame pixel sees
 };
-
-/** @brief An image of a frame seen through a camera, whatever its lens: when `camera` has lens
-distortion, `render(idealCamera, idealSize, out)` is called and its result warped into the
-frame with LensView::toFrame() (`interpolation` per output), else `render(camera, frameSize,
-out)` directly. What the mattes, the clones' depth and the compositor's virtual layer use.
-@param camera the frame's camera.
-@param frameSize the frame's size.
-@param render draws the images for a pinhole camera and size.
-@param outputs the images at frameSize (as many as render fills).
-@param interpolations one per output: INTER_LINEAR (colours, coverage), INTER_NEAREST (depth).
-@param borders one per output: value outside the ideal image.
-*/
-CV_EXPORTS void renderThroughLens(const Camera& camera, Size frameSize,
-                                  const std::function<void(const Camera&, Size,
-                                                           std::vector<Mat>&)>& render,
-                                  std::vector<Mat>& outputs,
-                                  const std::vector<int>& interpolations,
-                                  const std::vector<Scalar>& borders = std::vector<Scalar>());
 
 //! @}
 
