@@ -78,6 +78,10 @@ void registerSfm(CLI::App& app, Globals& g)
             info(g, "  perspective BA:      " + statsLine(rep.perspective));
         if (rep.lens.observations > 0)
             info(g, "  lens BA:             " + statsLine(rep.lens));
+        if (rep.unexplainedObservations > 0)
+            info(g, cv::format("  final BA, without the %d observations beyond %.2f px: ",
+                               rep.unexplainedObservations, rep.unexplainedThresholdPx) +
+                 statsLine(rep.explained));
         info(g, lensLine(rep));
         info(g, "wrote " + args->out);
     });

@@ -167,6 +167,16 @@ only when focal + k1 beat the focal alone), so that a
     double lensInlierPx = 3.0;
     //! Self-calibration: largest relative standard deviation of the focal that is trusted.
     double maxFocalRelStd = 0.01;
+    /** Perspective cameras: rounds of the final bundle adjustment on the observations the
+    cameras explain. Each round leaves out every observation whose reprojection error exceeds
+    3.16 times the median one (the 99.9th percentile of the residual length under Gaussian
+    noise, its scale from the median): tracks an occluding contour dragged along after their
+    point went out of sight, T-junctions of contours at different depths, which the tracker's
+    forward-backward check cannot see and per-track rejection keeps when most of the track is
+    good. A point left with fewer than 3 explained observations is dropped. Rounds stop when
+    the count left out stops changing. With self-calibration the lens is chosen again on the
+    observations the first choice explains. 0: every observation is used (before issue 15). */
+    int explainedRounds = 3;
 };
 
 //! What recoverCameras() did.
@@ -197,6 +207,12 @@ struct CV_EXPORTS SfmReport
     std::vector<double> lensBic;
     //! after the lens bundle adjustment (if run), against the original observations
     ReprojectionStats lens;
+    //! observations the final cameras do not explain, left out (SfmOptions::explainedRounds)
+    int unexplainedObservations = 0;
+    //! the reprojection error beyond which they were left out, pixels (0: none judged)
+    double unexplainedThresholdPx = 0;
+    //! the final cameras against the observations they explain
+    ReprojectionStats explained;
 };
 
 /** @brief Factorization, the paper's 3F+1 refinement, optional full bundle adjustment, model
@@ -212,7 +228,9 @@ Steps:
    points, the refiner's robust loss) on the original, distorted observations, the intrinsics
    held (or refined with SfmOptions::refineIntrinsics). Unknown: the self-calibration of
    SfmOptions::selfCalibrate when the perspective model was kept.
-4. The rejected tracks the final cameras explain are kept (through the lens).
+4. Perspective cameras: the final bundle adjustment again on the observations the cameras
+   explain (SfmOptions::explainedRounds; with self-calibration the lens is chosen again on them).
+5. The rejected tracks the final cameras explain are kept (through the lens).
 @param tracks the tracks.
 @param options see SfmOptions.
 @param report optional: what was done and the error after each stage.
