@@ -297,7 +297,9 @@ TEST(Augocc_SfmLens, far_away_keeps_prior)
     EXPECT_TRUE(rep.lensModel == "none" || rep.lensModel == "focal") << rep.lensModel;
     EXPECT_FALSE(rep.lensReason.empty());
     if (rec.model == PERSPECTIVE)
+    {
         EXPECT_TRUE(rec.cameras.front().distortion.empty());
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
