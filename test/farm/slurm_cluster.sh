@@ -57,7 +57,8 @@ CONF
     export SLURM_CONF=$dir/slurm.conf
     munged --foreground --force --key-file="$dir/munge/munge.key" \
         --socket="$dir/munge/munge.socket" --pid-file="$dir/munge/munged.pid" \
-        --log-file="$dir/log/munged.log" --seed-file="$dir/munge/munged.seed" &
+        --log-file="$dir/log/munged.log" --seed-file="$dir/munge/munged.seed" \
+        >"$dir/log/munged.stdout" 2>&1 &
     CLUSTER_PIDS+=($!)
     for i in $(seq 50); do
         [ -S "$dir/munge/munge.socket" ] && break

@@ -81,8 +81,8 @@ check_same() {
         fail "$what: the joined video's codec differs from the single-machine one"
     # The decoded frames, in order: one encode of the same frames with the same encoder and
     # settings (x264 is deterministic), so equal hashes, no tolerance needed.
-    ffmpeg -v error -i "$T/ref.mp4" -f framemd5 "$T/ref.md5"
-    ffmpeg -v error -i "$T/shot/composite.mp4" -f framemd5 "$T/joined.md5"
+    ffmpeg -y -v error -i "$T/ref.mp4" -f framemd5 "$T/ref.md5"
+    ffmpeg -y -v error -i "$T/shot/composite.mp4" -f framemd5 "$T/joined.md5"
     diff <(grep -v '^#' "$T/ref.md5") <(grep -v '^#' "$T/joined.md5") >/dev/null ||
         fail "$what: the joined video's decoded frames differ from the single-machine video's"
     echo "$what: joined outputs = single-machine outputs (16 frames)"
