@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 namespace opencv_test {
 namespace {
@@ -230,6 +231,81 @@ TEST(Augocc_Farm, plan_file_round_trip)
     EXPECT_EQ(ob.setup, o.setup);
     EXPECT_FALSE(ob.photoRefine);
     EXPECT_THROW(readPlan((dir / "nothing").string(), back, ob), UsageError);
+    fs::remove_all(dir);
+}
+
+// Every file under `a` equals the one under `b` of the same relative path, and the file counts
+// match.
+void expectSameTree(const fs::path& a, const fs::path& b)
+{
+    int na = 0, nb = 0;
+    for (const auto& e : fs::recursive_directory_iterator(a))
+        if (e.is_regular_file())
+        {
+            na++;
+            const fs::path other = b / fs::relative(e.path(), a);
+            std::ifstream fa(e.path(), std::ios::binary), fb(other, std::ios::binary);
+            const std::string x((std::istreambuf_iterator<char>(fa)), {}),
+                y((std::istreambuf_iterator<char>(fb)), {});
+            EXPECT_TRUE(!x.empty() && x == y) << e.path() << " differs from " << other;
+        }
+    for (const auto& e : fs::recursive_directory_iterator(b))
+        nb += e.is_regular_file() ? 1 : 0;
+    EXPECT_EQ(na, nb) << a << " and " << b;
+}
+
+// The chunks of composite and matte (--frames a:b), joined, are the single run's outputs byte
+// for byte: what the farm's chunk array and join do, without Slurm.
+TEST(Augocc_Farm, chunks_joined_equal_the_whole)
+{
+    const fs::path dir = tempDir("farm_chunks");
+    const std::string a = augoccBinary() + " --quiet ";
+    const std::string d = dir.string() + "/";
+    std::ofstream(dir / "scene.yml")
+        << "%YAML:1.0\n---\nobjects:\n"
+        << "  - { name: tree, shape: tree, in_front_of: building, distance: 0.15, size: 0.6 }\n";
+    std::string out;
+    ASSERT_EQ(runCommand(a + "synth --out " + d + "src --frames 8 --size 96x72", &out), 0) << out;
+    ASSERT_EQ(runCommand(a + "track --input " + d + "src/video.mp4 --out " + d + "t.yml", &out),
+              0) << out;
+    ASSERT_EQ(runCommand(a + "sfm --tracks " + d + "t.yml --out " + d + "r.yml", &out), 0) << out;
+    ASSERT_EQ(runCommand(a + "clone --reconstruction " + d + "r.yml --masks " + d +
+                         "src/input/masks --tracks " + d + "t.yml --out " + d + "c.yml.gz", &out),
+              0) << out;
+    const std::string comp = a + "composite --input " + d + "src/video.mp4 --reconstruction " + d +
+                             "r.yml --clones " + d + "c.yml.gz --scene " + d + "scene.yml ";
+    ASSERT_EQ(runCommand(comp + "--out " + d + "whole --mattes " + d + "whole_m", &out), 0) << out;
+    ASSERT_EQ(runCommand(comp + "--frames 5: --out " + d + "c1 --mattes " + d + "c1_m", &out), 0)
+        << out;
+    ASSERT_EQ(runCommand(comp + "--frames 0:5 --out " + d + "c0 --mattes " + d + "c0_m", &out), 0)
+        << out;
+    ASSERT_EQ(runCommand(a + "join --kind frames --out " + d + "joined " + d + "c1 " + d + "c0",
+                         &out), 0) << out;
+    ASSERT_EQ(runCommand(a + "join --kind masks --out " + d + "joined_m " + d + "c0_m " + d +
+                         "c1_m", &out), 0) << out;
+    expectSameTree(dir / "whole", dir / "joined");
+    expectSameTree(dir / "whole_m", dir / "joined_m");
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir / "joined"), fs::directory_iterator()), 8);
+
+    // matte --frames: chunks of the mattes alone, joined, = augocc matte of every frame.
+    const std::string matte = a + "matte --reconstruction " + d + "r.yml --clones " + d +
+                              "c.yml.gz --out " + d;
+    ASSERT_EQ(runCommand(matte + "m_all", &out), 0) << out;
+    ASSERT_EQ(runCommand(matte + "m0 --frames 0:3", &out), 0) << out;
+    ASSERT_EQ(runCommand(matte + "m1 --frames 3:", &out), 0) << out;
+    ASSERT_EQ(runCommand(a + "join --kind masks --out " + d + "m_joined " + d + "m0 " + d + "m1",
+                         &out), 0) << out;
+    expectSameTree(dir / "m_all", dir / "m_joined");
+    expectSameTree(dir / "whole_m", dir / "m_all");  // composite's mattes are matte's
+    // A frame past the reconstruction's cameras: exit 2, nothing written.
+    EXPECT_EQ(runCommand(matte + "m_bad --frames 5:20", &out), 2);
+    EXPECT_NE(out.find("--frames 5:20: frame 19 is beyond the last frame 7"), std::string::npos)
+        << out;
+    EXPECT_FALSE(fs::exists(dir / "m_bad"));
+    // Overlapping chunks: exit 2 naming the frame.
+    EXPECT_EQ(runCommand(a + "join --kind frames --out " + d + "j2 " + d + "c0 " + d + "whole",
+                         &out), 2);
+    EXPECT_NE(out.find("frame 0 is also in"), std::string::npos) << out;
     fs::remove_all(dir);
 }
 

@@ -212,8 +212,6 @@ void runFarm(const Globals& g, const FarmCliOptions& o)
             throw UsageError("--chunk-frames, --chunks: give one of them");
         w.chunks = 4;
     }
-    if (w.chunkFrames < 0 || w.chunks < 0)
-        throw UsageError("--chunk-frames / --chunks: must be positive");
     const std::vector<Shot> shots = shotsOf(o);
     std::vector<Plan> plans;
     for (const Shot& s : shots)
@@ -269,9 +267,10 @@ void registerFarm(CLI::App& app, Globals& g)
     sub->add_option("--scene", o->scene, "one shot: scene.yml (without it the chunks write "
                     "mattes only)");
     sub->add_option("--out-dir", o->outDir, "one shot: its outputs, and farm/ (scripts, logs)");
-    sub->add_option("--chunk-frames", o->workflow.chunkFrames, "frames per chunk job");
+    sub->add_option("--chunk-frames", o->workflow.chunkFrames, "frames per chunk job")
+        ->check(CLI::PositiveNumber);
     sub->add_option("--chunks", o->workflow.chunks, "number of chunk jobs (default 4 when "
-                    "--chunk-frames is not given)");
+                    "--chunk-frames is not given)")->check(CLI::PositiveNumber);
     sub->add_option("--partition", o->workflow.partition, "Slurm partition (#SBATCH "
                     "--partition)");
     sub->add_option("--account", o->workflow.account, "Slurm account (#SBATCH --account)");
