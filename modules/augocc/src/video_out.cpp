@@ -8,6 +8,7 @@
 #include "atomic_write.hpp"
 #include "video_out.hpp"
 
+#include <cctype>
 #include <filesystem>
 
 namespace fs = std::filesystem;
