@@ -17,6 +17,8 @@ PACKAGES=(
     xvfb xdotool                          # end-to-end test of the interactive annotate tool
     ffmpeg                                # ffprobe for video checks in tests; ffmpeg for synth --bitrate
     doxygen texlive-base                  # API docs and their test (bibtex for @cite)
+    slurm-wlm munge                       # augocc farm's test: a single-node Slurm cluster
+    shellcheck                            # the farm's generated job scripts are checked with it
 )
 
 missing=()

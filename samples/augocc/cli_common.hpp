@@ -103,6 +103,8 @@ void registerRun(CLI::App& app, Globals& g);
 void registerDemo(CLI::App& app, Globals& g);
 void registerAnnotate(CLI::App& app, Globals& g);
 void registerPropagate(CLI::App& app, Globals& g);
+void registerJoin(CLI::App& app, Globals& g);
+void registerFarm(CLI::App& app, Globals& g);
 
 } // namespace augocc_cli
 

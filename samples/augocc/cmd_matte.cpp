@@ -11,7 +11,7 @@ namespace {
 
 struct MatteOptions
 {
-    std::string reconstruction, clones, out, depth;
+    std::string reconstruction, clones, out, depth, frames;
 };
 
 void runMatte(const MatteOptions& o, const Globals& g)
@@ -19,7 +19,25 @@ void runMatte(const MatteOptions& o, const Globals& g)
     using namespace cv::augocc;
     requireFile("--reconstruction", o.reconstruction);
     requireFile("--clones", o.clones);
-    const Reconstruction rec = readReconstruction(o.reconstruction);
+    std::vector<FrameRange> ranges;
+    if (!o.frames.empty())
+        ranges = parseFrameRanges("--frames", o.frames);
+    Reconstruction rec = readReconstruction(o.reconstruction);
+    if (!o.frames.empty())
+    {
+        // A chunk (augocc farm): the cameras of the chosen frames only, each one required.
+        const int frameCount = rec.cameras.empty() ? 0 : rec.cameras.back().frame + 1;
+        const std::set<int> frames = listFrames("--frames", o.frames, ranges, frameCount);
+        std::vector<Camera> chosen;
+        for (int f : frames)
+        {
+            if (rec.findCamera(f) < 0)
+                throw UsageError(cv::format("--frames: frame %d has no camera in %s", f,
+                                            o.reconstruction.c_str()));
+            chosen.push_back(rec.camera(f));
+        }
+        rec.cameras = chosen;
+    }
     const cv::Ptr<CloneSet> clones = CloneSet::load(o.clones);
     Progress progress(g, "matte", (int)rec.cameras.size());
     writeMattes(o.out, *clones, rec, o.depth);
@@ -42,6 +60,8 @@ void registerMatte(CLI::App& app, Globals& g)
     sub->add_option("--clones", o->clones, "clones file from augocc clone")->required();
     sub->add_option("--out", o->out, "MATTES folder to write: <object>/%04d.png")->required();
     sub->add_option("--depth", o->depth, "also write depth maps here: <object>/%04d.tiff");
+    sub->add_option("--frames", o->frames, "only these frames, e.g. 0:50 (frames 0..49, a render "
+                    "farm chunk; README, Command line); default: every frame with a camera");
     sub->callback([o, &g]() { runMatte(*o, g); });
 }
 

@@ -29,6 +29,8 @@ int main(int argc, char** argv)
     registerDemo(app, g);
     registerAnnotate(app, g);
     registerPropagate(app, g);
+    registerJoin(app, g);
+    registerFarm(app, g);
 
     try
     {

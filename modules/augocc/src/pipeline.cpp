@@ -6,6 +6,7 @@
 #include "precomp.hpp"
 
 #include "atomic_write.hpp"
+#include "video_out.hpp"
 
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -17,13 +18,6 @@ namespace cv {
 namespace augocc {
 
 namespace {
-
-bool isVideoPath(const String& path)
-{
-    String e = fs::path(path).extension().string();
-    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-    return e == ".mp4" || e == ".avi" || e == ".mkv" || e == ".mov" || e == ".m4v";
-}
 
 // A temporary sibling of `path` with the same extension (video writers pick the container from
 // it), renamed onto `path` by commit(); removed on destruction otherwise.
@@ -93,22 +87,6 @@ void writeImage(const String& tmp, const String& shown, const String& name, cons
                            (fs::path(shown) / name).string());
 }
 
-VideoWriter openVideo(const String& tmp, const String& shown, double fps, Size size)
-{
-    // FFmpeg says nothing of why it cannot open a file: a folder we cannot write fails here.
-    detail::checkCreatable(tmp, shown);
-    VideoWriter writer;
-    // H.264 first (plays everywhere), MPEG-4 part 2 when this FFmpeg cannot encode it.
-    for (const char* cc : {"avc1", "H264", "mp4v"})
-    {
-        writer.open(tmp, CAP_FFMPEG, VideoWriter::fourcc(cc[0], cc[1], cc[2], cc[3]), fps, size,
-                    true);
-        if (writer.isOpened())
-            return writer;
-    }
-    CV_Error(Error::StsError, shown + ": cannot open a video writer (H.264 or mp4v)");
-}
-
 // Depth range of the 16-bit depth output, fixed for the sequence (first frame, 50% margin).
 struct DepthEncoding
 {
@@ -174,7 +152,7 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
             CV_Error(Error::StsBadArg, recName + cv::format(": frame %d has no camera (frames "
                      "%d:%d are to be composited)", f, first, end));
 
-    const bool video = isVideoPath(output);
+    const bool video = detail::isVideoPath(output);
     PendingOutput out(output);
     std::unique_ptr<PendingOutput> mattesOut, depthOut, layerOut;
     if (!options.mattesDir.empty())
@@ -204,8 +182,8 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
     comp->setVirtualObjects(virtualObjects);
     VideoWriter writer;
     if (video)
-        writer = openVideo(out.tmp(), output, options.fps > 0 ? options.fps : src->fps(),
-                           src->size());
+        writer = detail::openVideo(out.tmp(), output,
+                                   options.fps > 0 ? options.fps : src->fps(), src->size());
     DepthEncoding enc;
     src->seek(first);
     Mat frame, result, layer, depth, matte;

@@ -1,0 +1,421 @@
+// augocc farm: the Slurm workflow of a shot as data and script text (doc/farm.md).
+
+#include "farm_workflow.hpp"
+
+#include "cli_common.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <opencv2/augocc.hpp>
+
+namespace fs = std::filesystem;
+
+namespace augocc_cli {
+namespace farm {
+
+namespace {
+
+// Blanks in a path would break the #SBATCH lines (they cannot be quoted) and '%' is Slurm's
+// file-name pattern character.
+void checkFarmPath(const std::string& where, const std::string& path)
+{
+    if (path.find_first_of(" \t\n%") != std::string::npos)
+        throw UsageError(where + " " + path + ": an out-dir for the farm may not hold blanks or "
+                         "'%' (Slurm's #SBATCH lines cannot quote them)");
+}
+
+std::string absoluteFrom(const fs::path& base, const std::string& p)
+{
+    fs::path q(p);
+    if (q.is_relative())
+        q = base / q;
+    return q.lexically_normal().string();
+}
+
+const char* stageName(Stage s)
+{
+    static const char* names[] = {"sfm", "clone", "chunks", "join"};
+    return names[s];
+}
+
+// The shot's paths a stage's commands use (each variable set only where used: shellcheck).
+enum Uses { USES_INPUT = 1, USES_MASKS = 2, USES_SCENE = 4 };
+
+// #SBATCH header, strict mode, the user's environment lines, and the shot's variables.
+std::string header(const Plan& plan, const Options& o, Stage stage, const std::string& what,
+                   bool array, int uses)
+{
+    const Shot& s = plan.shot;
+    std::ostringstream t;
+    t << "#!/bin/bash\n"
+      << "# augocc farm: shot " << s.name << ", " << what << "\n"
+      << "# Written by augocc farm (doc/farm.md); edit freely, then\n"
+      << "#   augocc farm resume --out-dir " << s.outDir << "\n"
+      << "#SBATCH --job-name=augocc-" << s.name << "-" << stageName(stage) << "\n"
+      << "#SBATCH --output=" << s.outDir << "/farm/logs/%x-" << (array ? "%A_%a" : "%j")
+      << ".out\n";
+    if (!o.partition.empty())
+        t << "#SBATCH --partition=" << o.partition << "\n";
+    if (!o.account.empty())
+        t << "#SBATCH --account=" << o.account << "\n";
+    if (!o.timeLimit.empty())
+        t << "#SBATCH --time=" << o.timeLimit << "\n";
+    if (array)
+        t << "#SBATCH --array=0-" << plan.chunks.size() - 1 << "\n";
+    t << "set -euo pipefail\n";
+    if (!o.setup.empty())
+    {
+        t << "# The environment the jobs need (--setup):\n";
+        for (const std::string& line : o.setup)
+            t << line << "\n";
+    }
+    t << "AUGOCC=" << shellQuote(o.augocc) << "\n";
+    if (uses & USES_INPUT)
+        t << "INPUT=" << shellQuote(s.input) << "\n";
+    if (uses & USES_MASKS)
+        t << "MASKS=" << shellQuote(s.masks) << "\n";
+    if (uses & USES_SCENE)
+        t << "SCENE=" << shellQuote(s.scene) << "\n";
+    t << "cd " << shellQuote(s.outDir) << "\n";
+    return t.str();
+}
+
+} // namespace
+
+std::string shellQuote(const std::string& s)
+{
+    const bool safe = !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) {
+        return std::isalnum(c) || std::strchr("/._-+:,=@", c) != nullptr;
+    });
+    if (safe)
+        return s;
+    std::string q = "'";
+    for (char c : s)
+        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+std::string shotName(const std::string& outDir)
+{
+    fs::path p = fs::path(outDir).lexically_normal();
+    std::string name = p.filename().string();
+    if (name.empty())
+        name = p.parent_path().filename().string();
+    for (char& c : name)
+        if (!std::isalnum((unsigned char)c) && c != '.' && c != '_' && c != '-')
+            c = '_';
+    return name.empty() ? std::string("shot") : name;
+}
+
+std::vector<Shot> readShotsFile(const std::string& path)
+{
+    std::ifstream in(path);
+    if (!in)
+        throw UsageError("--shots " + path + ": cannot be read");
+    const fs::path base = fs::absolute(fs::path(path)).parent_path();
+    std::vector<Shot> shots;
+    std::string line;
+    for (int number = 1; std::getline(in, line); number++)
+    {
+        const size_t hash = line.find('#');
+        if (hash != std::string::npos)
+            line.resize(hash);
+        std::istringstream words(line);
+        std::vector<std::string> w;
+        for (std::string x; words >> x;)
+            w.push_back(x);
+        if (w.empty())
+            continue;
+        const std::string where = path + ":" + std::to_string(number);
+        if (w.size() != 4)
+            throw UsageError(where + ": expected 4 fields, input masks scene out-dir ('-' for no "
+                             "scene), found " + std::to_string(w.size()));
+        Shot s;
+        s.input = absoluteFrom(base, w[0]);
+        s.masks = absoluteFrom(base, w[1]);
+        s.scene = w[2] == "-" ? std::string() : absoluteFrom(base, w[2]);
+        s.outDir = absoluteFrom(base, w[3]);
+        checkFarmPath(where + ": out-dir", s.outDir);
+        s.name = shotName(s.outDir);
+        for (const Shot& other : shots)
+            if (other.name == s.name)
+                throw UsageError(where + ": out-dir " + s.outDir + " has the folder name of " +
+                                 other.outDir + " (job names come from it: make them differ)");
+        shots.push_back(s);
+    }
+    if (shots.empty())
+        throw UsageError("--shots " + path + ": no shot (a line 'input masks scene out-dir')");
+    return shots;
+}
+
+std::vector<std::pair<int, int> > splitFrames(int frameCount, int chunkFrames, int chunks)
+{
+    CV_Assert(frameCount > 0 && ((chunkFrames > 0) != (chunks > 0)));
+    std::vector<std::pair<int, int> > out;
+    if (chunkFrames > 0)
+    {
+        for (int a = 0; a < frameCount; a += chunkFrames)
+            out.push_back({a, std::min(frameCount, a + chunkFrames)});
+        return out;
+    }
+    const int n = std::min(chunks, frameCount);
+    for (int i = 0, a = 0; i < n; i++)
+    {
+        const int len = frameCount / n + (i < frameCount % n ? 1 : 0);
+        out.push_back({a, a + len});
+        a += len;
+    }
+    return out;
+}
+
+std::string chunkDir(const std::pair<int, int>& chunk)
+{
+    return cv::format("chunks/%04d-%04d", chunk.first, chunk.second);
+}
+
+std::vector<Script> makeScripts(const Plan& plan, const Options& o)
+{
+    const Shot& s = plan.shot;
+    const bool scene = !s.scene.empty();
+    std::vector<Script> scripts;
+
+    // 1. Tracking and camera recovery: one job (every frame's tracks feed one bundle adjustment).
+    std::ostringstream sfm;
+    sfm << header(plan, o, STAGE_SFM, "tracking and camera recovery (one job: the whole shot)",
+                  false, USES_INPUT)
+        << "# Each output is written all or nothing: a file present is finished.\n"
+        << "if [ ! -f tracks.yml ]; then\n"
+        << "    \"$AUGOCC\" --quiet track --input \"$INPUT\" --out tracks.yml\n"
+        << "fi\n"
+        << "if [ ! -f reconstruction.yml ]; then\n"
+        << "    \"$AUGOCC\" --quiet sfm --tracks tracks.yml --out reconstruction.yml\n"
+        << "fi\n";
+    scripts.push_back({STAGE_SFM, "1-sfm.sh", sfm.str()});
+
+    // 2. The clones: one job (the passes of all objects see each other, doc/farm.md).
+    std::ostringstream clone;
+    clone << header(plan, o, STAGE_CLONE, "the clones (one job: every object's clone hides the "
+                    "others in its passes)", false,
+                    USES_MASKS | (o.photoRefine ? USES_INPUT : 0))
+          << "if [ ! -f clones.yml.gz ]; then\n"
+          << "    \"$AUGOCC\" --quiet clone --reconstruction reconstruction.yml --masks \"$MASKS\" "
+             "\\\n        --tracks tracks.yml"
+          << (o.photoRefine ? " --input \"$INPUT\"" : "") << " --out clones.yml.gz\n"
+          << "fi\n";
+    scripts.push_back({STAGE_CLONE, "2-clone.sh", clone.str()});
+
+    // 3. The chunks: a job array, one task per frame range.
+    std::ostringstream first, end;
+    for (size_t i = 0; i < plan.chunks.size(); i++)
+    {
+        first << (i ? " " : "") << plan.chunks[i].first;
+        end << (i ? " " : "") << plan.chunks[i].second;
+    }
+    std::ostringstream chunks;
+    chunks << header(plan, o, STAGE_CHUNKS, std::string(scene ? "composite" : "mattes") +
+                     " of " + std::to_string(plan.chunks.size()) + " frame chunks (a job "
+                     "array, task i = chunk i)", true, scene ? USES_INPUT | USES_SCENE : 0)
+           << "# Chunk i is frames FIRST[i] .. END[i]-1.\n"
+           << "FIRST=(" << first.str() << ")\n"
+           << "END=(" << end.str() << ")\n"
+           << "i=${SLURM_ARRAY_TASK_ID:?run as a Slurm array task (sbatch), or set "
+              "SLURM_ARRAY_TASK_ID}\n"
+           << "dir=$(printf 'chunks/%04d-%04d' \"${FIRST[i]}\" \"${END[i]}\")\n"
+           << "# The outputs are written all or nothing: a chunk with them is finished.\n";
+    if (scene)
+        chunks << "if [ -d \"$dir/composite\" ] && [ -d \"$dir/mattes\" ]; then\n";
+    else
+        chunks << "if [ -d \"$dir/mattes\" ]; then\n";
+    chunks << "    echo \"$dir: finished before, not redone\"\n"
+           << "    exit 0\n"
+           << "fi\n"
+           << "mkdir -p \"$dir\"\n";
+    if (scene)
+        chunks << "\"$AUGOCC\" --quiet composite --input \"$INPUT\" --reconstruction "
+                  "reconstruction.yml \\\n    --clones clones.yml.gz --scene \"$SCENE\" "
+                  "--frames \"${FIRST[i]}:${END[i]}\" \\\n    --out \"$dir/composite\" "
+                  "--mattes \"$dir/mattes\"\n";
+    else
+        chunks << "\"$AUGOCC\" --quiet matte --reconstruction reconstruction.yml --clones "
+                  "clones.yml.gz \\\n    --frames \"${FIRST[i]}:${END[i]}\" --out "
+                  "\"$dir/mattes\"\n";
+    scripts.push_back({STAGE_CHUNKS, "3-chunks.sh", chunks.str()});
+
+    // 4. The join: PNG files copied, the video encoded once from the joined frames.
+    std::ostringstream join;
+    join << header(plan, o, STAGE_JOIN, "join of the chunks (PNG copied, the video encoded "
+                   "once)", false, 0);
+    auto list = [&](const char* sub) {
+        std::string l;
+        for (const auto& c : plan.chunks)
+            l += " \\\n        " + chunkDir(c) + "/" + sub;
+        return l;
+    };
+    join << "if [ ! -d mattes ]; then\n"
+         << "    \"$AUGOCC\" --quiet join --kind masks --out mattes" << list("mattes") << "\n"
+         << "fi\n";
+    if (scene)
+        join << "if [ ! -d composite ]; then\n"
+             << "    \"$AUGOCC\" --quiet join --kind frames --out composite" << list("composite")
+             << "\n"
+             << "fi\n"
+             << "if [ ! -f composite.mp4 ]; then\n"
+             << "    \"$AUGOCC\" --quiet join --kind frames --fps " << cv::format("%.17g", plan.fps)
+             << " --out composite.mp4 composite\n"
+             << "fi\n";
+    scripts.push_back({STAGE_JOIN, "4-join.sh", join.str()});
+    return scripts;
+}
+
+Status readStatus(const Plan& plan)
+{
+    const fs::path d(plan.shot.outDir);
+    const bool scene = !plan.shot.scene.empty();
+    auto isFile = [&](const fs::path& p) { return fs::is_regular_file(d / p); };
+    auto isDir = [&](const fs::path& p) { return fs::is_directory(d / p); };
+    Status p;
+    p.sfm = isFile("tracks.yml") && isFile("reconstruction.yml");
+    p.clone = isFile("clones.yml.gz");
+    for (const auto& c : plan.chunks)
+    {
+        const fs::path cd(chunkDir(c));
+        p.chunks.push_back(isDir(cd / "mattes") && (!scene || isDir(cd / "composite")));
+    }
+    p.join = isDir("mattes") && (!scene || (isDir("composite") && isFile("composite.mp4")));
+    return p;
+}
+
+std::vector<Submission> planSubmissions(const Plan& plan, const Status& p)
+{
+    std::vector<Submission> subs;
+    const std::string dir = (fs::path(plan.shot.outDir) / "farm").string();
+    const std::vector<Script> scripts = makeScripts(plan, Options());
+    auto add = [&](Stage st, std::vector<int> tasks) {
+        Submission s;
+        s.stage = st;
+        s.script = (fs::path(dir) / scripts[st].file).string();
+        s.arrayTasks = tasks;
+        s.dependsOn = subs.empty() ? -1 : (int)subs.size() - 1;
+        subs.push_back(s);
+    };
+    if (p.join)
+        return subs;
+    if (!p.sfm)
+        add(STAGE_SFM, {});
+    if (!p.clone)
+        add(STAGE_CLONE, {});
+    std::vector<int> tasks;
+    for (size_t i = 0; i < plan.chunks.size(); i++)
+        if (i >= p.chunks.size() || !p.chunks[i])
+            tasks.push_back((int)i);
+    if (!tasks.empty())
+        add(STAGE_CHUNKS, tasks);
+    add(STAGE_JOIN, {});
+    return subs;
+}
+
+std::string arraySpec(const std::vector<int>& tasks)
+{
+    std::string s;
+    for (size_t i = 0; i < tasks.size();)
+    {
+        size_t j = i;
+        while (j + 1 < tasks.size() && tasks[j + 1] == tasks[j] + 1)
+            j++;
+        s += (s.empty() ? "" : ",") + std::to_string(tasks[i]) +
+             (j > i ? "-" + std::to_string(tasks[j]) : std::string());
+        i = j + 1;
+    }
+    return s;
+}
+
+std::vector<std::string> sbatchArgs(const Submission& s, const std::string& dependency)
+{
+    std::vector<std::string> a = {"--parsable"};
+    if (!s.arrayTasks.empty())
+        a.push_back("--array=" + arraySpec(s.arrayTasks));
+    if (!dependency.empty())
+    {
+        a.push_back("--dependency=afterok:" + dependency);
+        // A failed stage cancels the ones waiting for it (else they pend for ever).
+        a.push_back("--kill-on-invalid-dep=yes");
+    }
+    a.push_back(s.script);
+    return a;
+}
+
+void writePlan(const Plan& plan, const Options& o)
+{
+    const std::string path = (fs::path(plan.shot.outDir) / "farm" / "plan.yml").string();
+    cv::FileStorage fsw(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+    fsw << "description" << "augocc farm: the shot's workflow (augocc farm resume reads it)";
+    fsw << "name" << plan.shot.name << "input" << plan.shot.input << "masks" << plan.shot.masks
+        << "scene" << plan.shot.scene << "out_dir" << plan.shot.outDir;
+    fsw << "frame_count" << plan.frameCount << "fps" << plan.fps;
+    fsw << "chunks" << "[";
+    for (const auto& c : plan.chunks)
+        fsw << "[:" << c.first << c.second << "]";
+    fsw << "]";
+    fsw << "partition" << o.partition << "account" << o.account << "time" << o.timeLimit
+        << "augocc" << o.augocc << "photo_refine" << (int)o.photoRefine;
+    fsw << "setup" << "[";
+    for (const std::string& l : o.setup)
+        fsw << l;
+    fsw << "]";
+    const std::string text = fsw.releaseAndGetString();
+    cv::augocc::writeAtomically(path, [&](const cv::String& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        out.close();
+        if (!out)
+            CV_Error(cv::Error::StsError, path + ": cannot be written");
+    });
+}
+
+void readPlan(const std::string& outDir, Plan& plan, Options& o)
+{
+    const std::string path = (fs::path(outDir) / "farm" / "plan.yml").string();
+    if (!fs::is_regular_file(path))
+        throw UsageError("--out-dir " + outDir + ": no farm/plan.yml (submit it with augocc "
+                         "farm first)");
+    cv::FileStorage f(path, cv::FileStorage::READ);
+    auto str = [&](const char* key) {
+        const cv::FileNode n = f[key];
+        if (!n.isString())
+            throw UsageError(path + ": key '" + key + "' missing or not a string");
+        return n.string();
+    };
+    plan.shot.name = str("name");
+    plan.shot.input = str("input");
+    plan.shot.masks = str("masks");
+    plan.shot.scene = str("scene");
+    plan.shot.outDir = str("out_dir");
+    if (!f["frame_count"].isInt() || !f["fps"].isReal() || !f["chunks"].isSeq())
+        throw UsageError(path + ": frame_count, fps or chunks missing");
+    plan.frameCount = (int)f["frame_count"];
+    plan.fps = (double)f["fps"];
+    plan.chunks.clear();
+    for (const cv::FileNode& c : f["chunks"])
+    {
+        if (!c.isSeq() || c.size() != 2)
+            throw UsageError(path + ": chunks: each entry must be [first, end]");
+        plan.chunks.push_back({(int)c[0], (int)c[1]});
+    }
+    if (plan.chunks.empty())
+        throw UsageError(path + ": chunks is empty");
+    o.partition = str("partition");
+    o.account = str("account");
+    o.timeLimit = str("time");
+    o.augocc = str("augocc");
+    o.photoRefine = (int)f["photo_refine"] != 0;
+    o.setup.clear();
+    for (const cv::FileNode& l : f["setup"])
+        o.setup.push_back(l.string());
+}
+
+} // namespace farm
+} // namespace augocc_cli

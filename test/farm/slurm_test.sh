@@ -1,0 +1,133 @@
+#!/bin/bash
+# augocc farm on a real single-node Slurm cluster (issue 21; doc/farm.md): a tiny synthesized
+# shot in 4 composite chunks; the joined outputs must equal a single-machine `augocc composite`
+# and `augocc matte` of the same inputs (PNG folders byte for byte, the H.264 video frame for
+# frame after decoding, 16 frames each by ffprobe). Then chunk 2 is killed mid-way, `augocc farm
+# resume` submits it alone (and the join), and the result is the same again.
+# Usage: slurm_test.sh AUGOCC_BINARY. Exit 77 (CTest: skipped) without slurm-wlm/munge or root.
+set -euo pipefail
+AUGOCC=$(realpath "$1")
+here=$(cd "$(dirname "$0")" && pwd)
+# shellcheck source=SCRIPTDIR/slurm_cluster.sh
+. "$here/slurm_cluster.sh"
+
+if [ "$(id -u)" -ne 0 ]; then
+    echo "SKIP: the Slurm test starts munged, slurmctld and slurmd as root; not root"
+    exit 77
+fi
+if ! cluster_have_slurm; then
+    echo "SKIP: slurm-wlm and munge are not installed (scripts/setup.sh installs them)"
+    exit 77
+fi
+
+T=$(mktemp -d /tmp/augocc_farm_test.XXXXXX)
+cleanup() {
+    cluster_stop
+    rm -rf "$T"
+}
+trap cleanup EXIT
+fail() {
+    echo "FAIL: $*" >&2
+    for f in "$T"/shot/farm/logs/*; do
+        [ -f "$f" ] && { echo "--- $f" >&2; cat "$f" >&2; }
+    done
+    exit 1
+}
+
+# The shot: 16 frames of 160x120, its key-frame masks, a tree in front of the building.
+"$AUGOCC" --quiet synth --out "$T/src" --frames 16 --size 160x120
+cat >"$T/scene.yml" <<'YML'
+%YAML:1.0
+---
+objects:
+  - { name: tree, shape: tree, in_front_of: building, distance: 0.15, size: 0.6 }
+  - { name: dome, shape: dome, behind: building, distance: 0.05, size: 0.6, offset: [-0.45, 0, 0] }
+YML
+video=$T/src/video.mp4
+masks=$T/src/input/masks
+
+cluster_start "$T/cluster" || fail "the cluster did not start"
+"$AUGOCC" farm --input "$video" --masks "$masks" --scene "$T/scene.yml" --out-dir "$T/shot" \
+    --chunks 4 --augocc "$AUGOCC" --sbatch "$(command -v sbatch)" --time 00:10:00 |
+    tee "$T/submit.txt"
+grep -q "chunks 0-3" "$T/submit.txt" || fail "the 4 chunks were not submitted as one array"
+cluster_wait 600 || fail "the jobs did not finish"
+[ -f "$T/shot/composite.mp4" ] || fail "no joined composite.mp4"
+
+# Single machine, the same inputs (the shot's own reconstruction and clones).
+"$AUGOCC" --quiet composite --input "$video" --reconstruction "$T/shot/reconstruction.yml" \
+    --clones "$T/shot/clones.yml.gz" --scene "$T/scene.yml" --out "$T/ref_composite" \
+    --mattes "$T/ref_mattes"
+"$AUGOCC" --quiet composite --input "$video" --reconstruction "$T/shot/reconstruction.yml" \
+    --clones "$T/shot/clones.yml.gz" --scene "$T/scene.yml" --out "$T/ref.mp4"
+
+frames_of() {
+    ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames \
+        -of csv=p=0 "$1"
+}
+check_same() {
+    local what=$1
+    diff -r "$T/ref_composite" "$T/shot/composite" >/dev/null ||
+        fail "$what: the joined composite PNGs differ from the single-machine run"
+    diff -r "$T/ref_mattes" "$T/shot/mattes" >/dev/null ||
+        fail "$what: the joined mattes differ from the single-machine run"
+    [ "$(find "$T/shot/composite" -name '*.png' | wc -l)" -eq 16 ] ||
+        fail "$what: the joined composite does not hold 16 frames"
+    [ "$(frames_of "$T/shot/composite.mp4")" = 16 ] ||
+        fail "$what: composite.mp4 does not hold 16 frames"
+    [ "$(ffprobe -v error -select_streams v:0 -show_entries stream=codec_name -of csv=p=0 \
+        "$T/shot/composite.mp4")" = "$(ffprobe -v error -select_streams v:0 \
+        -show_entries stream=codec_name -of csv=p=0 "$T/ref.mp4")" ] ||
+        fail "$what: the joined video's codec differs from the single-machine one"
+    # The decoded frames, in order: one encode of the same frames with the same encoder and
+    # settings (x264 is deterministic), so equal hashes, no tolerance needed.
+    ffmpeg -y -v error -i "$T/ref.mp4" -f framemd5 "$T/ref.md5"
+    ffmpeg -y -v error -i "$T/shot/composite.mp4" -f framemd5 "$T/joined.md5"
+    diff <(grep -v '^#' "$T/ref.md5") <(grep -v '^#' "$T/joined.md5") >/dev/null ||
+        fail "$what: the joined video's decoded frames differ from the single-machine video's"
+    echo "$what: joined outputs = single-machine outputs (16 frames)"
+}
+check_same "4 chunks"
+
+# Chunk 2 killed mid-way: its outputs (and the join's) gone as if it had not finished yet,
+# then its script run by hand and killed (SIGKILL) while its temporary output exists.
+chunk=$T/shot/chunks/0008-0012
+rm -rf "$chunk" "$T/shot/composite" "$T/shot/mattes" "$T/shot/composite.mp4"
+# Its own session, so that the kill reaches augocc and not only the shell running it.
+SLURM_ARRAY_TASK_ID=2 setsid bash "$T/shot/farm/3-chunks.sh" >"$T/killed.log" 2>&1 &
+pid=$!
+killed=0
+for _ in $(seq 3000); do
+    if compgen -G "$chunk/.composite.tmp*" >/dev/null; then
+        kill -KILL -- "-$pid"
+        killed=1
+        break
+    fi
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.01
+done
+wait "$pid" 2>/dev/null || true
+[ "$killed" = 1 ] || fail "chunk 2 ended before it could be killed mid-way"
+[ ! -e "$chunk/composite" ] || fail "a chunk killed mid-way left a composite (not all or nothing)"
+compgen -G "$chunk/.composite.tmp*" >/dev/null || fail "the killed chunk left no temporary"
+
+"$AUGOCC" farm resume --out-dir "$T/shot" --sbatch "$(command -v sbatch)" | tee "$T/resume.txt"
+grep -q "3-chunks job [0-9]* (chunks 2)" "$T/resume.txt" ||
+    fail "resume did not submit chunk 2 alone"
+if grep -q "1-sfm\|2-clone" "$T/resume.txt"; then
+    fail "resume submitted a finished stage again"
+fi
+cluster_wait 600 || fail "the resumed jobs did not finish"
+if compgen -G "$chunk/.composite.tmp*" >/dev/null; then
+    fail "the killed chunk's temporary is still there after the resume"
+fi
+check_same "chunk 2 killed and resumed"
+"$AUGOCC" farm resume --out-dir "$T/shot" --sbatch "$(command -v sbatch)" | grep -q "nothing to submit" ||
+    fail "resume of a finished shot submitted something"
+
+started=("${CLUSTER_PIDS[@]}")
+cluster_stop
+for pid in "${started[@]}"; do
+    kill -0 "$pid" 2>/dev/null && fail "daemon $pid still running"
+done
+echo "PASS"
