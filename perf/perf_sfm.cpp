@@ -123,7 +123,7 @@ void Augocc_FeatureTracker_track(benchmark::State& state)
     for (auto _ : state)
     {
         tracker->track(frames, tracks);
-        benchmark::DoNotOptimize(tracks.tracks.data);
+        benchmark::DoNotOptimize(tracks.observations());
     }
     if (tracks.points() == 0)
         state.SkipWithError("no track");

@@ -82,16 +82,15 @@ BENCHMARK(Augocc_SilhouetteEditor_snapMask)->Name("Augocc_SilhouetteEditor/snapM
 void Augocc_KeyFrames_suggest(benchmark::State& state)
 {
     const int F = int(state.range(0)), P = 1000;
-    Tracks t;
-    t.imageSize = Size(640, 480);
-    t.tracks = Mat(F, P, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    Mat m(F, P, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
     RNG rng(1);
     for (int p = 0; p < P; ++p)
     {
         const int a = rng.uniform(0, F), b = rng.uniform(a, F);
         for (int f = a; f <= b; ++f)
-            t.tracks.at<Point2f>(f, p) = Point2f(float(p % 640), float(f % 480));
+            m.at<Point2f>(f, p) = Point2f(float(p % 640), float(f % 480));
     }
+    const Tracks t = Tracks::fromDense(Size(640, 480), m);
     for (auto _ : state)
     {
         std::vector<int> keys = suggestKeyFrames(t, 8);

@@ -118,10 +118,8 @@ SfmProblem makeSfmProblem(const SfmProblemParams& prm)
         if (out.outlier[p])
             gt.points.row(p).setTo(std::numeric_limits<double>::quiet_NaN());
     out.groundTruth = gt;
-    out.tracks.imageSize = prm.imageSize;
-    out.tracks.tracks = noisy;
-    out.cleanTracks.imageSize = prm.imageSize;
-    out.cleanTracks.tracks = clean;
+    out.tracks = Tracks::fromDense(prm.imageSize, noisy);
+    out.cleanTracks = Tracks::fromDense(prm.imageSize, clean);
     return out;
 }
 

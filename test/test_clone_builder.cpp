@@ -500,18 +500,15 @@ TEST(Augocc_CloneBuilder, cli_clone_and_matte)
     // --no-free-space keeps the silhouettes-only clone; tracks that do not match the points: 2.
     {
         const int F = (int)s.rec.cameras.size(), P = s.rec.points.rows;
-        Tracks t;
-        t.imageSize = s.rec.imageSize;
-        t.tracks = Mat(F, P, CV_32FC2);
+        Mat m(F, P, CV_32FC2);
         for (int f = 0; f < F; f++)
             for (int p = 0; p < P; p++)
             {
                 const Point2d q = s.rec.project(f, Vec3d(s.rec.points.ptr<double>(p)));
-                t.tracks.at<Vec2f>(f, p) = Vec2f((float)q.x, (float)q.y);
+                m.at<Vec2f>(f, p) = Vec2f((float)q.x, (float)q.y);
             }
-        writeTracks(dir + "/tracks.yml", t);
-        t.tracks = t.tracks.colRange(0, P / 2).clone();
-        writeTracks(dir + "/half.yml", t);
+        writeTracks(dir + "/tracks.yml", Tracks::fromDense(s.rec.imageSize, m));
+        writeTracks(dir + "/half.yml", Tracks::fromDense(s.rec.imageSize, m.colRange(0, P / 2)));
     }
     ASSERT_EQ(runCommand(bin + " --quiet clone --reconstruction " + dir + "/rec.yml --masks " + dir +
                          "/masks --out " + dir + "/t1.yml.gz --tracks " + dir + "/tracks.yml", &out),

@@ -30,14 +30,6 @@ const double kShortTrackMaxRotDeg = 2.0;
 const double kSlowOrbitRotDeg = 1.0;
 const double kSlowOrbitMaxRotDeg = 2.0;
 
-Tracks makeTracks(int F, int P)
-{
-    Tracks t;
-    t.imageSize = Size(640, 480);
-    t.tracks = Mat(F, P, CV_32FC2, Scalar::all(100));
-    return t;
-}
-
 TEST(Augocc_FactorizationSfM, can_create_default)
 {
     Ptr<FactorizationSfM> sfm = FactorizationSfM::create();
@@ -193,9 +185,11 @@ TEST(Augocc_FactorizationSfM, bad_arg_pure_translation)
         prm.points = 100;
         prm.orbitDegrees = 0;
         SfmProblem pb = makeSfmProblem(prm);
+        Mat m = pb.tracks.dense();
         for (int f = 0; f < prm.frames; f++)
             for (int p = 0; p < prm.points; p++)
-                pb.tracks.tracks.at<Point2f>(f, p) += Point2f(2.0f * f, -1.0f * f);
+                m.at<Point2f>(f, p) += Point2f(2.0f * f, -1.0f * f);
+        pb.tracks = Tracks::fromDense(pb.tracks.imageSize, m);
         Reconstruction rec;
         try
         {
@@ -218,9 +212,10 @@ TEST(Augocc_FactorizationSfM, bad_arg_two_distinct_views)
     prm.points = 100;
     prm.noiseSigma = 0;
     const SfmProblem two = makeSfmProblem(prm);
-    Tracks t = makeTracks(10, prm.points);
+    Mat m(10, prm.points, CV_32FC2);
     for (int f = 0; f < 10; f++)
-        two.tracks.tracks.row(f % 2).copyTo(t.tracks.row(f));
+        two.tracks.dense({f % 2}).copyTo(m.row(f));
+    const Tracks t = Tracks::fromDense(Size(640, 480), m);
     Reconstruction rec;
     EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
 }
@@ -236,14 +231,15 @@ TEST(Augocc_FactorizationSfM, bad_arg_planar_rank)
         prm.frames = frames;
         prm.points = 50;
         SfmProblem pb = makeSfmProblem(prm);
-        Tracks t = pb.tracks;
+        Mat m = pb.tracks.dense();
         for (int f = 0; f < prm.frames; f++)
             for (int p = 0; p < prm.points; p++)
             {
                 const double a = p / 50.0;
-                t.tracks.at<Point2f>(f, p) = Point2f((float)(100 + 200 * a + f),
-                                                     (float)(100 + 50 * a * (1 + 0.01 * f)));
+                m.at<Point2f>(f, p) = Point2f((float)(100 + 200 * a + f),
+                                              (float)(100 + 50 * a * (1 + 0.01 * f)));
             }
+        const Tracks t = Tracks::fromDense(pb.tracks.imageSize, m);
         Reconstruction rec;
         EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
     }
@@ -258,10 +254,10 @@ TEST(Augocc_FactorizationSfM, bad_arg_too_few_tracks)
     Reconstruction rec;
     EXPECT_THROW(FactorizationSfM::create()->reconstruct(pb.tracks, rec), cv::Exception);
     // Enough columns but too few seen twice.
-    Tracks t = makeTracks(10, 6);
-    t.tracks.setTo(Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    Mat m(10, 6, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
     for (int p = 0; p < 6; p++)
-        t.tracks.at<Point2f>(p % 10, p) = Point2f(10, 10);
+        m.at<Point2f>(p % 10, p) = Point2f(10, 10);
+    const Tracks t = Tracks::fromDense(Size(640, 480), m);
     EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
 }
 
@@ -272,16 +268,19 @@ TEST(Augocc_FactorizationSfM, bad_arg_non_finite)
     prm.points = 50;
     SfmProblem pb = makeSfmProblem(prm);
     Reconstruction rec;
-    Tracks t = pb.tracks;
-    t.tracks.at<Point2f>(3, 4) = Point2f(std::numeric_limits<float>::infinity(),
-                                         std::numeric_limits<float>::infinity());
-    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
-    t.tracks = pb.tracks.tracks.clone();
-    t.tracks.at<Point2f>(3, 4).x = std::numeric_limits<float>::quiet_NaN();
-    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
+    // Tracks cannot hold a non-finite observation: the dense matrix is refused when built.
+    Mat m = pb.tracks.dense();
+    m.at<Point2f>(3, 4) = Point2f(std::numeric_limits<float>::infinity(),
+                                  std::numeric_limits<float>::infinity());
+    EXPECT_THROW(Tracks::fromDense(pb.tracks.imageSize, m), cv::Exception);
+    m = pb.tracks.dense();
+    m.at<Point2f>(3, 4).x = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_THROW(Tracks::fromDense(pb.tracks.imageSize, m), cv::Exception);
     // Wrong type.
-    t.tracks = Mat(10, 50, CV_64FC2, Scalar::all(1));
-    EXPECT_THROW(FactorizationSfM::create()->reconstruct(t, rec), cv::Exception);
+    EXPECT_THROW(Tracks::fromDense(pb.tracks.imageSize, Mat(10, 50, CV_32SC2, Scalar::all(1))),
+                 cv::Exception);
+    // Empty tracks.
+    EXPECT_THROW(FactorizationSfM::create()->reconstruct(Tracks(), rec), cv::Exception);
     // Bad params.
     FactorizationSfM::Params p;
     p.minTrackLength = 1;

@@ -191,7 +191,7 @@ TEST(Augocc_FeatureTracker, multithread_reproducibility)
     FeatureTracker::create()->track(frames, a);
     setNumThreads(4);
     FeatureTracker::create()->track(frames, b);
-    EXPECT_TRUE(identicalWithNan(a.tracks, b.tracks));
+    EXPECT_TRUE(identicalWithNan(a.dense(), b.dense()));
 }
 
 // `augocc track` then `augocc sfm` on a synthesized video, no ground-truth tracks: the issue's

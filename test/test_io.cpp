@@ -21,17 +21,15 @@ const float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 Tracks makeTracks(int frames, int points)
 {
-    Tracks t;
-    t.imageSize = Size(640, 480);
-    t.tracks.create(frames, points, CV_32FC2);
+    Mat m(frames, points, CV_32FC2);
     RNG rng(3);
     for (int f = 0; f < frames; f++)
         for (int p = 0; p < points; p++)
-            t.tracks.at<Point2f>(f, p) = ((p % 3 == 0) && (f > p % frames))
-                                             ? Point2f(kNaN, kNaN)
-                                             : Point2f(rng.uniform(0.f, 640.f),
-                                                       rng.uniform(0.f, 480.f));
-    return t;
+            m.at<Point2f>(f, p) = ((p % 3 == 0) && (f > p % frames))
+                                      ? Point2f(kNaN, kNaN)
+                                      : Point2f(rng.uniform(0.f, 640.f),
+                                                rng.uniform(0.f, 480.f));
+    return Tracks::fromDense(Size(640, 480), m);
 }
 
 Reconstruction makeReconstruction(CameraModel model)
@@ -88,8 +86,9 @@ TEST(Augocc_Tracks, regression_round_trip)
         writeTracks(p, t);
         const Tracks r = readTracks(p);
         EXPECT_EQ(r.imageSize, t.imageSize);
-        ASSERT_EQ(r.tracks.size(), t.tracks.size());
-        ASSERT_EQ(r.tracks.type(), CV_32FC2);
+        ASSERT_EQ(r.frames(), t.frames());
+        ASSERT_EQ(r.points(), t.points());
+        ASSERT_EQ(r.observations(), t.observations());
         for (int f = 0; f < t.frames(); f++)
             for (int p2 = 0; p2 < t.points(); p2++)
             {
@@ -135,6 +134,239 @@ TEST(Augocc_Tracks, bad_arg)
     const std::string halfNaN = writeText(dir, "halfnan.yml", head + sz + "frames: 1\npoints: 1\n"
         "tracks: !!opencv-matrix\n   rows: 1\n   cols: 1\n   dt: \"2f\"\n   data: [ 1., .Nan ]\n");
     expectErrorMentions([&] { readTracks(halfNaN); }, {"halfnan.yml", "NaN"});
+}
+
+// Tracks of a long shot with re-detection: every track lives `len` frames, a new one starts
+// every `every` frames, so N = P * len grows linearly with F while F x P grows with F^2.
+Tracks makeLongTracks(int frames, int len, int perStart, int every = 1)
+{
+    Tracks::Builder b(Size(640, 360), frames);
+    RNG rng(5);
+    for (int s = 0; s + len <= frames; s += every)
+        for (int k = 0; k < perStart; k++)
+        {
+            b.addTrack();
+            Point2f q(rng.uniform(0.f, 640.f), rng.uniform(0.f, 360.f));
+            for (int f = s; f < s + len; f++)
+                b.add(f, q += Point2f(0.5f, 0.25f));
+        }
+    return b.build();
+}
+
+std::string readBytes(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void expectSameTracks(const Tracks& r, const Tracks& t)
+{
+    EXPECT_EQ(r.imageSize, t.imageSize);
+    ASSERT_EQ(r.frames(), t.frames());
+    ASSERT_EQ(r.points(), t.points());
+    ASSERT_EQ(r.observations(), t.observations());
+    for (int i = 0; i < t.observations(); i++)
+    {
+        ASSERT_EQ(r.frameOf(i), t.frameOf(i));
+        ASSERT_EQ(r.pointOf(i), t.pointOf(i));
+        ASSERT_EQ(r.uv(i), t.uv(i)) << i;  // float -> text (or base64) -> float is exact
+    }
+}
+
+TEST(Augocc_Tracks, regression_round_trip_both_forms)
+{
+    const std::string dir = tempDir("io");
+    // 64 observations (text) and 1200 (base64 in the sparse form).
+    for (const Tracks& t : {makeTracks(7, 11), makeLongTracks(300, 20, 10, 50)})
+        for (TracksForm form : {TRACKS_DENSE, TRACKS_SPARSE, TRACKS_SMALLER})
+            for (const char* name : {"tracks.yml", "tracks.yml.gz", "tracks.json"})
+            {
+                SCOPED_TRACE(cv::format("%d observations, form %d, %s", t.observations(),
+                                        (int)form, name));
+                const std::string p = dir + "/" + name;
+                writeTracks(p, t, form);
+                expectSameTracks(readTracks(p), t);
+            }
+    // The dense form is the file the dense writer always wrote, byte for byte.
+    const Tracks t = makeTracks(7, 11);
+    writeTracks(dir + "/dense.yml", t, TRACKS_DENSE);
+    FileStorage fs(".yml", FileStorage::WRITE | FileStorage::MEMORY);
+    fs << "image_size" << (Mat_<int>(1, 2) << 640, 480) << "frames" << 7 << "points" << 11
+       << "tracks" << t.dense();
+    EXPECT_EQ(readBytes(dir + "/dense.yml"), fs.releaseAndGetString());
+    // The sparse form follows the contract: obs_index (frame, point) sorted by point, then frame.
+    writeTracks(dir + "/sparse.yml", t, TRACKS_SPARSE);
+    FileStorage in(dir + "/sparse.yml", FileStorage::READ);
+    Mat index, uv;
+    in["obs_index"] >> index;
+    in["obs_uv"] >> uv;
+    EXPECT_TRUE(in["tracks"].empty());
+    ASSERT_EQ(index.type(), CV_32S);
+    ASSERT_EQ(uv.type(), CV_32F);
+    ASSERT_EQ(index.rows, t.observations());
+    for (int i = 1; i < index.rows; i++)
+        EXPECT_LT(std::make_pair(index.at<int>(i - 1, 1), index.at<int>(i - 1, 0)),
+                  std::make_pair(index.at<int>(i, 1), index.at<int>(i, 0)));
+}
+
+TEST(Augocc_Tracks, regression_observation_order)
+{
+    // Any order of observations reads the same; the frame index lists points increasing.
+    const Tracks t = makeTracks(7, 11);
+    const int N = t.observations();
+    Mat index(N, 2, CV_32S), uv(N, 2, CV_32F);
+    for (int i = 0; i < N; i++)
+    {
+        const int j = (i * 7) % N;  // a permutation: N is not a multiple of 7 (asserted)
+        index.at<int>(j, 0) = t.frameOf(i);
+        index.at<int>(j, 1) = t.pointOf(i);
+        uv.at<float>(j, 0) = t.uv(i).x;
+        uv.at<float>(j, 1) = t.uv(i).y;
+    }
+    ASSERT_NE(N % 7, 0);
+    expectSameTracks(Tracks::fromObservations(t.imageSize, 7, 11, index, uv), t);
+    for (int f = 0; f < t.frames(); f++)
+    {
+        const Range r = t.frame(f);
+        for (int k = r.start; k < r.end; k++)
+        {
+            EXPECT_EQ(t.frameOf(t.byFrame(k)), f);
+            if (k > r.start)
+            {
+                EXPECT_LT(t.pointOf(t.byFrame(k - 1)), t.pointOf(t.byFrame(k)));
+            }
+        }
+    }
+    EXPECT_MAT_NEAR(Tracks::fromDense(t.imageSize, t.dense()).dense(), t.dense(), 0);
+    // A sub-block: frames {6, 0}, points {3, 1}.
+    const Mat block = t.dense({6, 0}, {3, 1});
+    ASSERT_EQ(block.size(), Size(2, 2));
+    for (int r = 0; r < 2; r++)
+        for (int c = 0; c < 2; c++)
+        {
+            const Point2f a = block.at<Point2f>(r, c), b = t.at(r ? 0 : 6, c ? 1 : 3);
+            EXPECT_TRUE(a == b || (std::isnan(a.x) && std::isnan(b.x)));
+        }
+}
+
+TEST(Augocc_Tracks, regression_size_rule)
+{
+    // writeTracks picks the smaller text: the dense form for full tracks, the sparse one for
+    // short ones; whichever it writes is the smaller of the two (compared before compression).
+    const std::string dir = tempDir("io");
+    const std::string p = dir + "/tracks.yml";
+    int dense = 0, sparse = 0;
+    for (int len : {2, 10, 40, 60})
+    {
+        const Tracks t = makeLongTracks(60, len, 12, 3);
+        SCOPED_TRACE(cv::format("tracks of %d frames, %d observations", len, t.observations()));
+        const size_t d = tracksFileBytes(p, t, TRACKS_DENSE);
+        const size_t s = tracksFileBytes(p, t, TRACKS_SPARSE);
+        writeTracks(p, t);
+        const std::string text = readBytes(p);
+        EXPECT_EQ(text.size(), std::min(d, s));
+        const bool isSparse = text.find("obs_index") != std::string::npos;
+        EXPECT_EQ(isSparse, s < d);
+        EXPECT_NE(isSparse, text.find("tracks:") != std::string::npos);
+        (isSparse ? sparse : dense)++;
+        // The rule's shortcut: every dense cell takes at least 8 bytes of text.
+        EXPECT_GE(d, (size_t)8 * t.frames() * t.points());
+    }
+    EXPECT_GT(dense, 0) << "full tracks: dense";
+    EXPECT_GT(sparse, 0) << "short tracks: sparse";
+}
+
+TEST(Augocc_Tracks, regression_long_shot_linear_size)
+{
+    // A 1800-frame shot whose tracks live 30 frames, 4 new each frame (re-detection): N = 2.1e5,
+    // F x P = 1800 x 7084 = 1.3e7 cells. The file is sparse and its size linear in N: bytes per
+    // observation at 1800 frames within 2 % of that at 180 (fixed headers are the difference).
+    const std::string dir = tempDir("io");
+    double perObs[2];
+    int k = 0;
+    for (int frames : {180, 1800})
+    {
+        const Tracks t = makeLongTracks(frames, 30, 4);
+        const std::string p = dir + cv::format("/long%d.yml", frames);
+        writeTracks(p, t);
+        const std::string text = readBytes(p);
+        EXPECT_NE(text.find("obs_index"), std::string::npos);
+        perObs[k++] = (double)text.size() / t.observations();
+        if (frames == 1800)
+            expectSameTracks(readTracks(p), t);
+    }
+    EXPECT_NEAR(perObs[1] / perObs[0], 1.0, 0.02) << perObs[0] << " " << perObs[1];
+    // 16 bytes an observation in base64: FileStorage's lines hold 48 bytes in 64 characters,
+    // indented 6 and broken by 1, so 16 x 71 / 48 = 23.7 bytes of text.
+    EXPECT_LT(perObs[1], 24.0);
+}
+
+TEST(Augocc_Tracks, bad_arg_sparse)
+{
+    const std::string dir = tempDir("io");
+    const std::string head = "%YAML:1.0\n---\n"
+                             "image_size: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: i\n"
+                             "   data: [ 640, 480 ]\nframes: 3\npoints: 2\n";
+    auto mat = [](const char* key, int rows, int cols, const char* dt, const char* data) {
+        return cv::format("%s: !!opencv-matrix\n   rows: %d\n   cols: %d\n   dt: %s\n"
+                          "   data: [ %s ]\n", key, rows, cols, dt, data);
+    };
+    const std::string uv2 = mat("obs_uv", 2, 2, "f", "1., 2., 3., 4.");
+    const std::string good = writeText(dir, "good.yml", head + mat("obs_index", 2, 2, "i",
+                                       "0, 0, 2, 1") + uv2);
+    const Tracks t = readTracks(good);
+    EXPECT_EQ(t.observations(), 2);
+    EXPECT_EQ(t.at(2, 1), Point2f(3, 4));
+    EXPECT_FALSE(t.observed(1, 1));
+    const std::string dense = mat("tracks", 3, 2, "\"2f\"", ".Nan, .Nan, .Nan, .Nan, .Nan, "
+                                  ".Nan, .Nan, .Nan, .Nan, .Nan, .Nan, .Nan");
+    struct Case { const char* name; std::string text; std::vector<std::string> says; };
+    const std::vector<Case> cases = {
+        {"both.yml", head + dense + mat("obs_index", 2, 2, "i", "0, 0, 2, 1") + uv2,
+         {"both", "tracks", "obs_index"}},
+        {"nouv.yml", head + mat("obs_index", 2, 2, "i", "0, 0, 2, 1"), {"obs_uv"}},
+        {"noindex.yml", head + uv2, {"obs_index"}},
+        {"shape.yml", head + mat("obs_index", 2, 3, "i", "0, 0, 0, 2, 1, 0") + uv2,
+         {"obs_index", "N x 2"}},
+        {"type.yml", head + mat("obs_index", 2, 2, "f", "0., 0., 2., 1.") + uv2,
+         {"obs_index", "32S"}},
+        {"uvtype.yml", head + mat("obs_index", 2, 2, "i", "0, 0, 2, 1") +
+         mat("obs_uv", 2, 2, "i", "1, 2, 3, 4"), {"obs_uv", "32F"}},
+        {"rows.yml", head + mat("obs_index", 1, 2, "i", "0, 0") + uv2, {"rows"}},
+        {"frame.yml", head + mat("obs_index", 2, 2, "i", "0, 0, 3, 1") + uv2,
+         {"obs_index", "row 1", "(3, 1)"}},
+        {"point.yml", head + mat("obs_index", 2, 2, "i", "0, -1, 2, 1") + uv2,
+         {"obs_index", "row 0"}},
+        {"twice.yml", head + mat("obs_index", 2, 2, "i", "2, 1, 2, 1") + uv2,
+         {"twice", "frame 2", "point 1"}},
+        {"nan.yml", head + mat("obs_index", 2, 2, "i", "0, 0, 2, 1") +
+         mat("obs_uv", 2, 2, "f", "1., .Nan, 3., 4."), {"obs_uv", "row 0", "not finite"}},
+        {"inf.yml", head + mat("obs_index", 2, 2, "i", "0, 0, 2, 1") +
+         mat("obs_uv", 2, 2, "f", "1., 2., .Inf, 4."), {"obs_uv", "row 1", "not finite"}},
+        {"zero.yml", "%YAML:1.0\n---\nimage_size: !!opencv-matrix\n   rows: 1\n   cols: 2\n"
+         "   dt: i\n   data: [ 640, 480 ]\nframes: 0\npoints: 2\n" +
+         mat("obs_index", 2, 2, "i", "0, 0, 2, 1") + uv2, {"frames = 0"}},
+    };
+    for (const Case& c : cases)
+    {
+        SCOPED_TRACE(c.name);
+        const std::string path = writeText(dir, c.name, c.text);
+        try
+        {
+            readTracks(path);
+            ADD_FAILURE() << "no exception";
+        }
+        catch (const cv::Exception& e)
+        {
+            EXPECT_NE(e.err.find(c.name), std::string::npos) << e.err;
+            for (const std::string& f : c.says)
+                EXPECT_NE(e.err.find(f), std::string::npos) << "'" << f << "' not in: " << e.err;
+        }
+    }
+    // A dense value that is infinite is refused when read, naming the entry.
+    const std::string inf = writeText(dir, "denseinf.yml", head + mat("tracks", 3, 2, "\"2f\"",
+        "1., 2., .Nan, .Nan, .Nan, .Nan, .Nan, .Nan, .Inf, .Inf, .Nan, .Nan"));
+    expectErrorMentions([&] { readTracks(inf); }, {"denseinf.yml", "(2, 0)", "not finite"});
 }
 
 class Augocc_Reconstruction_P : public testing::TestWithParam<int> {};

@@ -77,9 +77,7 @@ TEST(Augocc_KeyFrames, bad_arg)
     nan.at<double>(0, 2) = std::numeric_limits<double>::quiet_NaN();
     EXPECT_THROW(selectKeyFrames(nan, 2), cv::Exception);
     EXPECT_THROW(viewChangeMatrix(Reconstruction()), cv::Exception);
-    Tracks t;
-    t.imageSize = Size(100, 100);
-    t.tracks = Mat(5, 3, CV_32FC2, Scalar(10, 10));
+    const Tracks t = Tracks::fromDense(Size(100, 100), Mat(5, 3, CV_32FC2, Scalar(10, 10)));
     EXPECT_THROW(visibilityChangeMatrix(t, std::vector<uchar>(2, 1)), cv::Exception);
     FrameMasks wrongSize;
     wrongSize[0] = Mat::zeros(50, 50, CV_8U);
@@ -126,17 +124,16 @@ TEST(Augocc_KeyFrames, accuracy_view_change)
 // after, the set of visible tracks does not change, so the key frames go into 20..40.
 TEST(Augocc_KeyFrames, accuracy_facet_appearing)
 {
-    Tracks t;
-    t.imageSize = Size(640, 480);
     const int F = 60, P = 70;
-    t.tracks = Mat(F, P, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    Mat m(F, P, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
     for (int f = 0; f < F; ++f)
         for (int p = 0; p < P; ++p)
         {
             const bool seen = p < 50 || f >= 20 + (p - 50);
             if (seen)
-                t.tracks.at<Point2f>(f, p) = Point2f(10.f + p, 10.f + f);
+                m.at<Point2f>(f, p) = Point2f(10.f + p, 10.f + f);
         }
+    const Tracks t = Tracks::fromDense(Size(640, 480), m);
     const std::vector<int> keys = suggestKeyFrames(t, 4);
     ASSERT_EQ(4u, keys.size());
     EXPECT_EQ(0, keys.front());
@@ -157,16 +154,15 @@ TEST(Augocc_KeyFrames, accuracy_facet_appearing)
 
 TEST(Augocc_KeyFrames, object_tracks_from_masks)
 {
-    Tracks t;
-    t.imageSize = Size(100, 100);
-    t.tracks = Mat(3, 4, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    Mat d(3, 4, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
     // Track 0 inside in frame 0; track 1 inside in frame 0 but outside in frame 2; track 2
     // outside; track 3 only seen in frame 1 (no mask there).
-    t.tracks.at<Point2f>(0, 0) = Point2f(20, 20);
-    t.tracks.at<Point2f>(0, 1) = Point2f(25, 25);
-    t.tracks.at<Point2f>(2, 1) = Point2f(80, 80);
-    t.tracks.at<Point2f>(0, 2) = Point2f(80, 80);
-    t.tracks.at<Point2f>(1, 3) = Point2f(20, 20);
+    d.at<Point2f>(0, 0) = Point2f(20, 20);
+    d.at<Point2f>(0, 1) = Point2f(25, 25);
+    d.at<Point2f>(2, 1) = Point2f(80, 80);
+    d.at<Point2f>(0, 2) = Point2f(80, 80);
+    d.at<Point2f>(1, 3) = Point2f(20, 20);
+    const Tracks t = Tracks::fromDense(Size(100, 100), d);
     FrameMasks m;
     m[0] = Mat::zeros(100, 100, CV_8U);
     m[2] = Mat::zeros(100, 100, CV_8U);
@@ -192,16 +188,15 @@ TEST(Augocc_KeyFrames, object_tracks_from_masks)
 
 TEST(Augocc_KeyFrames, multithread_reproducibility)
 {
-    Tracks t;
-    t.imageSize = Size(640, 480);
     RNG rng(3);
-    t.tracks = Mat(80, 300, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    Mat d(80, 300, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
     for (int p = 0; p < 300; ++p)
     {
         const int a = rng.uniform(0, 80), b = rng.uniform(a, 80);
         for (int f = a; f <= b; ++f)
-            t.tracks.at<Point2f>(f, p) = Point2f(1.f, 1.f);
+            d.at<Point2f>(f, p) = Point2f(1.f, 1.f);
     }
+    const Tracks t = Tracks::fromDense(Size(640, 480), d);
     setNumThreads(1);
     const Mat one = visibilityChangeMatrix(t);
     const std::vector<int> k1 = suggestKeyFrames(t, 6);

@@ -455,7 +455,7 @@ TEST(Augocc_SceneSynthesizer, regression_deterministic)
         EXPECT_EQ(cv::norm(a.frames[f], b.frames[f], NORM_INF), 0) << "frame " << f;
         EXPECT_EQ(cv::norm(a.depth[f], b.depth[f], NORM_INF), 0) << "frame " << f;
     }
-    EXPECT_EQ(cv::norm(a.tracks.tracks != b.tracks.tracks, NORM_INF), 0)
+    EXPECT_EQ(cv::norm(a.tracks.dense() != b.tracks.dense(), NORM_INF), 0)
         << "same tracks, NaN at the same places";
     EXPECT_GT(cv::norm(a.frames[0], c.frames[0], NORM_L1), 0) << "another seed, other textures";
 }
@@ -478,7 +478,7 @@ TEST(Augocc_SceneSynthesizer, multithread_reproducibility)
             EXPECT_EQ(cv::norm(a.visibleMasks[name][(int)f], b.visibleMasks[name][(int)f],
                                NORM_INF), 0);
     }
-    EXPECT_EQ(cv::norm(a.tracks.tracks != b.tracks.tracks, NORM_INF), 0);
+    EXPECT_EQ(cv::norm(a.tracks.dense() != b.tracks.dense(), NORM_INF), 0);
 }
 
 TEST(Augocc_SceneSynthesizer, render_frame_and_virtual)

@@ -96,9 +96,7 @@ HandheldProblem makeHandheld(const HandheldParams& p)
     for (int i = 0; i < p.points; i++)
         for (int k = 0; k < 3; k++)
             out.truth.points.at<double>(i, k) = X[i][k];
-    out.tracks.imageSize = p.imageSize;
-    out.tracks.tracks = Mat(p.frames, p.points, CV_32FC2,
-                            Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    Mat m(p.frames, p.points, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
     for (int i = 0; i < p.points; i++)
     {
         const int len = rng.uniform(std::max(2, p.frames / 3), p.frames + 1);
@@ -112,11 +110,12 @@ HandheldProblem makeHandheld(const HandheldParams& p)
             if (q.x < 0 || q.y < 0 || q.x > p.imageSize.width - 1 ||
                 q.y > p.imageSize.height - 1)
                 continue;
-            out.tracks.tracks.at<Point2f>(f, i) = Point2f(
+            m.at<Point2f>(f, i) = Point2f(
                 (float)(q.x + rng.gaussian(p.noiseSigma)),
                 (float)(q.y + rng.gaussian(p.noiseSigma)));
         }
     }
+    out.tracks = Tracks::fromDense(p.imageSize, m);
     return out;
 }
 

@@ -374,9 +374,8 @@ TEST(Augocc_SfmRealData, oxford_dinosaur_geometry_square_pixels)
         sq.cameras.push_back(Camera::perspective(Ra * R, Ra * t,
                              Matx33d(fl, 0, centre.x, 0, fl, centre.y, 0, 0, 1), f));
     }
-    Tracks rendered = tracks;
-    rendered.tracks = Mat(tracks.tracks.size(), CV_32FC2,
-                          Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    Mat rendered(tracks.frames(), tracks.points(), CV_32FC2,
+                 Scalar::all(std::numeric_limits<float>::quiet_NaN()));
     RNG rng(36);
     const double kNoisePx = 0.2;
     for (int f = 0; f < 36; f++)
@@ -388,11 +387,12 @@ TEST(Augocc_SfmRealData, oxford_dinosaur_geometry_square_pixels)
             const Vec3d Xw(x[0], x[1], x[2]);
             ASSERT_GT(sq.cameras[f].toCamera(Xw)[2], 0);
             const Point2d q = sq.cameras[f].project(Xw);
-            rendered.tracks.at<Point2f>(f, p) = Point2f((float)(q.x + rng.gaussian(kNoisePx)),
-                                                        (float)(q.y + rng.gaussian(kNoisePx)));
+            rendered.at<Point2f>(f, p) = Point2f((float)(q.x + rng.gaussian(kNoisePx)),
+                                                 (float)(q.y + rng.gaussian(kNoisePx)));
         }
     SfmReport rep;
-    const Reconstruction rec = recoverCameras(rendered, SfmOptions(), &rep);
+    const Reconstruction rec = recoverCameras(Tracks::fromDense(tracks.imageSize, rendered),
+                                              SfmOptions(), &rep);
     ASSERT_EQ(36, (int)rec.cameras.size());
     const CameraComparison cmp = compareCameras(rec, sq, rec.model == SCALED_ORTHOGRAPHIC);
     std::cout << "oxford_dinosaur geometry, square-pixel cameras, " << kNoisePx << " px noise: "

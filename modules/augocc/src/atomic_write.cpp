@@ -301,14 +301,13 @@ void writeImageFile(const String& file, InputArray img, const String& shown)
     writeFileBytes(file, buf.data(), buf.size(), shown);
 }
 
-void writeStorageFile(const String& file, const std::function<void(FileStorage&)>& fill,
-                      const String& shown)
+String storageText(const std::function<void(FileStorage&)>& fill, const String& shown, int flags)
 {
     const String name = fs::path(shown).filename().string();
     const bool gz = endsWith(name, ".gz");
     // With MEMORY, the name only picks the format; FileStorage compresses files, not memory.
     FileStorage storage(gz ? name.substr(0, name.size() - 3) : name,
-                        FileStorage::WRITE | FileStorage::MEMORY);
+                        FileStorage::WRITE | FileStorage::MEMORY | flags);
     if (!storage.isOpened())
         CV_Error(Error::StsError, shown + ": cannot start a FileStorage in memory");
     fill(storage);
@@ -316,8 +315,14 @@ void writeStorageFile(const String& file, const std::function<void(FileStorage&)
     if (!storage.isOpened())
         CV_Error(Error::StsInternal, shown + ": the FileStorage was released before it was "
                  "written");
-    const String text = storage.releaseAndGetString();
-    if (gz)
+    return storage.releaseAndGetString();
+}
+
+void writeStorageFile(const String& file, const std::function<void(FileStorage&)>& fill,
+                      const String& shown, int flags)
+{
+    const String text = storageText(fill, shown, flags);
+    if (endsWith(fs::path(shown).filename().string(), ".gz"))
     {
         const String packed = gzipCompress(text, shown);
         writeFileBytes(file, packed.data(), packed.size(), shown);
@@ -326,9 +331,10 @@ void writeStorageFile(const String& file, const std::function<void(FileStorage&)
         writeFileBytes(file, text.data(), text.size(), shown);
 }
 
-void writeStorageAtomically(const String& path, const std::function<void(FileStorage&)>& fill)
+void writeStorageAtomically(const String& path, const std::function<void(FileStorage&)>& fill,
+                            int flags)
 {
-    writeAtomically(path, [&](const String& tmp) { writeStorageFile(tmp, fill, path); });
+    writeAtomically(path, [&](const String& tmp) { writeStorageFile(tmp, fill, path, flags); });
 }
 
 void checkCreatable(const String& file, const String& shown)

@@ -47,12 +47,18 @@ writeFileBytes; StsError naming `shown`. */
 void writeImageFile(const String& file, InputArray img, const String& shown);
 
 /** @brief Writes a FileStorage file: `fill` writes its nodes into a storage in memory (format
-from `shown`'s name: .yml, .json, .xml, + .gz compressed here), then writeFileBytes. */
+from `shown`'s name: .yml, .json, .xml, + .gz compressed here), then writeFileBytes.
+`flags` are added to WRITE | MEMORY (FileStorage::BASE64 for raw data in base64). */
 void writeStorageFile(const String& file, const std::function<void(FileStorage&)>& fill,
-                      const String& shown);
+                      const String& shown, int flags = 0);
+
+//! The text writeStorageFile would write for `shown` (before compression).
+String storageText(const std::function<void(FileStorage&)>& fill, const String& shown,
+                   int flags = 0);
 
 //! writeStorageFile under writeAtomically.
-void writeStorageAtomically(const String& path, const std::function<void(FileStorage&)>& fill);
+void writeStorageAtomically(const String& path, const std::function<void(FileStorage&)>& fill,
+                            int flags = 0);
 
 /** @brief Creates `file` empty, so that a folder a library cannot write into (read-only,
 permissions, missing) is an error with the OS reason before the library fails without one. */

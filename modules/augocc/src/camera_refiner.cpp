@@ -29,13 +29,15 @@ ReprojectionStats computeReprojectionStats(const Reconstruction& rec, const Trac
     {
         if (cam.frame < 0 || cam.frame >= tracks.frames())
             continue;
-        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
-        for (int p = 0; p < tracks.points(); p++)
+        const Range obs = tracks.frame(cam.frame);
+        for (int k = obs.start; k < obs.end; k++)
         {
-            if (!std::isfinite(row[p].x) || !rec.hasPoint(p))
+            const int p = tracks.pointOf(tracks.byFrame(k));
+            const Point2f o = tracks.uv(tracks.byFrame(k));
+            if (!rec.hasPoint(p))
                 continue;
             const Point2d q = cam.project(rec.point(p));
-            const double d = std::hypot(q.x - row[p].x, q.y - row[p].y);
+            const double d = std::hypot(q.x - o.x, q.y - o.y);
             e.push_back(d);
             s2 += d * d;
         }
@@ -158,16 +160,21 @@ void forEachObservationPointMajor(const Tracks& tracks, const Reconstruction& re
     for (int i = 0; i < n; i++)
         pp[i] = rec.cameras[i].principalPoint();
     used.assign(rec.points.rows, 0);
+    // Cameras are in increasing frame order, as are a track's observations.
+    std::vector<int> cameraOf(tracks.frames(), -1);
+    for (int i = 0; i < n; i++)
+        cameraOf[rec.cameras[i].frame] = i;
     for (int p = 0; p < rec.points.rows; p++)
     {
         if (!rec.hasPoint(p))
             continue;
-        for (int i = 0; i < n; i++)
+        const Range obs = tracks.track(p);
+        for (int k = obs.start; k < obs.end; k++)
         {
-            const Point2f o = tracks.tracks.at<Point2f>(rec.cameras[i].frame, p);
-            if (!std::isfinite(o.x))
+            const int i = cameraOf[tracks.frameOf(k)];
+            if (i < 0)
                 continue;
-            fn(i, p, o, pp[i]);
+            fn(i, p, tracks.uv(k), pp[i]);
             used[p] = 1;
         }
     }
@@ -208,17 +215,19 @@ bool OrthoCameraRefinerImpl::refinePositionZoom(const Tracks& tracks, Reconstruc
     for (int i = 0; i < n; i++)
     {
         const Camera& cam = rec.cameras[i];
-        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
+        const Range obs = tracks.frame(cam.frame);
         std::vector<double> rotated, observed;
-        for (int p = 0; p < tracks.points(); p++)
+        for (int k = obs.start; k < obs.end; k++)
         {
-            if (!std::isfinite(row[p].x) || !rec.hasPoint(p))
+            const int p = tracks.pointOf(tracks.byFrame(k));
+            const Point2f o = tracks.uv(tracks.byFrame(k));
+            if (!rec.hasPoint(p))
                 continue;
             const Vec3d Xc = cam.R * rec.point(p);
             rotated.push_back(Xc[0]);
             rotated.push_back(Xc[1]);
-            observed.push_back(row[p].x);
-            observed.push_back(row[p].y);
+            observed.push_back(o.x);
+            observed.push_back(o.y);
         }
         if (observed.empty())
             continue;
@@ -587,6 +596,10 @@ int rescueTracks(const Tracks& tracks, Reconstruction& rec)
 {
     const int P = rec.points.rows;
     std::vector<uchar> ok(P, 0);
+    std::vector<const Camera*> cameraOf(tracks.frames(), nullptr);
+    for (const Camera& c : rec.cameras)
+        if (c.frame < tracks.frames())
+            cameraOf[c.frame] = &c;
     parallel_for_(Range(0, P), [&](const Range& r) {
         for (int p = r.start; p < r.end; p++)
         {
@@ -595,11 +608,12 @@ int rescueTracks(const Tracks& tracks, Reconstruction& rec)
             double* X = rec.points.ptr<double>(p);
             std::vector<const Camera*> cams;
             std::vector<Point2d> obs;
-            for (const Camera& c : rec.cameras)
-                if (c.frame < tracks.frames() && tracks.observed(c.frame, p))
+            const Range seen = tracks.track(p);  // frames increasing, as the cameras
+            for (int k = seen.start; k < seen.end; k++)
+                if (const Camera* c = cameraOf[tracks.frameOf(k)])
                 {
-                    const Point2f o = tracks.at(c.frame, p);
-                    cams.push_back(&c);
+                    const Point2f o = tracks.uv(k);
+                    cams.push_back(c);
                     obs.push_back(Point2d(o.x, o.y));
                 }
             if ((int)cams.size() < kRescueMinViews)
@@ -693,12 +707,14 @@ double sumSquaredResiduals(const Tracks& tracks, const Reconstruction& rec,
         inlierOut->clear();
     for (const Camera& cam : rec.cameras)
     {
-        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
-        for (int p = 0; p < tracks.points(); p++)
+        const Range obs = tracks.frame(cam.frame);
+        for (int k = obs.start; k < obs.end; k++)
         {
-            if (!std::isfinite(row[p].x) || !rec.hasPoint(p))
+            const int p = tracks.pointOf(tracks.byFrame(k));
+            const Point2f o = tracks.uv(tracks.byFrame(k));
+            if (!rec.hasPoint(p))
                 continue;
-            const Point2d e = cam.project(rec.point(p)) - Point2d(row[p].x, row[p].y);
+            const Point2d e = cam.project(rec.point(p)) - Point2d(o.x, o.y);
             const double e2 = e.dot(e);
             const bool in = inlier ? (*inlier)[k] != 0 : e2 <= inlierPx * inlierPx;
             if (inlierOut)
@@ -1035,26 +1051,14 @@ bool knownLens(const SfmOptions& o, Size imageSize, Camera& lens)
 // image centre would see them (what the affine and perspective stages assume).
 Tracks idealTracks(const Tracks& tracks, const Camera& lens)
 {
-    Tracks ideal = tracks;
-    ideal.tracks = tracks.tracks.clone();
     const Point2d c((tracks.imageSize.width - 1) * 0.5, (tracks.imageSize.height - 1) * 0.5);
     const Matx33d& K = lens.K;
-    parallel_for_(Range(0, ideal.frames()), [&](const Range& r) {
-        for (int f = r.start; f < r.end; f++)
-        {
-            Point2f* row = ideal.tracks.ptr<Point2f>(f);
-            for (int p = 0; p < ideal.points(); p++)
-            {
-                if (!std::isfinite(row[p].x))
-                    continue;
-                const Point2d u = lens.undistortPixel(Point2d(row[p].x, row[p].y));
-                const double y = (u.y - K(1, 2)) / K(1, 1);
-                const double x = (u.x - K(0, 2) - K(0, 1) * y) / K(0, 0);
-                row[p] = Point2f((float)(K(0, 0) * x + c.x), (float)(K(0, 0) * y + c.y));
-            }
-        }
-    });
-    return ideal;
+    return tracks.mapped([&](int, int, const Point2f& q) {
+        const Point2d u = lens.undistortPixel(Point2d(q.x, q.y));
+        const double y = (u.y - K(1, 2)) / K(1, 1);
+        const double x = (u.x - K(0, 2) - K(0, 1) * y) / K(0, 0);
+        return Point2f((float)(K(0, 0) * x + c.x), (float)(K(0, 0) * y + c.y));
+    }, tracks.imageSize);
 }
 
 // The perspective solution of the ideal tracks brought to the known lens: each camera is

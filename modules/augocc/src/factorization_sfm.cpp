@@ -24,43 +24,27 @@ namespace detail {
 
 void ObservationIndex::build(const Tracks& tracks, const String& what)
 {
+    tracks.validate(what);  // every observation finite
     frames = tracks.frames();
     points = tracks.points();
-    // Two passes (count, then fill arrays of the exact size): growing the arrays by push_back
-    // copied and page-faulted them several times, half the cost of a 100 x 1000 factorization.
+    const int N = tracks.observations();
     frameStart.assign(frames + 1, 0);
     pointStart.assign(points + 1, 0);
     for (int f = 0; f < frames; f++)
-    {
-        const Point2f* row = tracks.tracks.ptr<Point2f>(f);
-        int n = 0;
-        for (int p = 0; p < points; p++)
-        {
-            const Point2f q = row[p];
-            if (std::isnan(q.x) && std::isnan(q.y))
-                continue;
-            if (!std::isfinite(q.x) || !std::isfinite(q.y))
-                CV_Error(Error::StsBadArg, what + cv::format(": tracks (%d, %d) is not finite "
-                         "(only a NaN pair may mark an unobserved entry)", f, p));
-            pointStart[p + 1]++;
-            n++;
-        }
-        frameStart[f + 1] = frameStart[f] + n;
-    }
+        frameStart[f + 1] = frameStart[f] + tracks.frameObservationCount(f);
     for (int p = 0; p < points; p++)
-        pointStart[p + 1] += pointStart[p];
-    byFrame.resize(frameStart[frames]);
-    byPoint.resize(frameStart[frames]);
+        pointStart[p + 1] = pointStart[p] + tracks.observationCount(p);
+    byFrame.resize(N);
+    byPoint.resize(N);
     std::vector<int> fill(pointStart.begin(), pointStart.end() - 1);
     int i = 0;
     for (int f = 0; f < frames; f++)
     {
-        const Point2f* row = tracks.tracks.ptr<Point2f>(f);
-        for (int p = 0; p < points; p++)
+        const Range r = tracks.frame(f);
+        for (int k = r.start; k < r.end; k++)
         {
-            const Point2f q = row[p];
-            if (std::isnan(q.x))
-                continue;
+            const int o = tracks.byFrame(k), p = tracks.pointOf(o);
+            const Point2f q = tracks.uv(o);
             byFrame[i] = SfmObservation{f, p, (double)q.x, (double)q.y};
             byPoint[fill[p]++] = i++;
         }

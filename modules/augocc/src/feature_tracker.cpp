@@ -84,17 +84,15 @@ public:
         for (int k = 0; k < (int)tracks_.size(); k++)
             if ((int)tracks_[k].pts.size() >= p_.minTrackLength)
                 keep.push_back(k);
-        Tracks out;
-        out.imageSize = size_;
-        const float nan = std::numeric_limits<float>::quiet_NaN();
-        out.tracks = Mat(frameIndex_, (int)keep.size(), CV_32FC2, Scalar::all(nan));
+        Tracks::Builder out(size_, frameIndex_);
         for (int c = 0; c < (int)keep.size(); c++)
         {
             const TrackRec& t = tracks_[keep[c]];
+            out.addTrack();
             for (size_t i = 0; i < t.pts.size(); i++)
-                out.tracks.at<Point2f>(t.start + (int)i, c) = t.pts[i];
+                out.add(t.start + (int)i, t.pts[i]);
         }
-        return out;
+        return out.build("FeatureTracker");
     }
 
     int frames() const { return frameIndex_; }

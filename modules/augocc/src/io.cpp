@@ -7,7 +7,9 @@
 #include "atomic_write.hpp"
 #include "frame_pattern.hpp"
 
+#include <atomic>
 #include <cstdio>
+#include <numeric>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -123,17 +125,231 @@ FileStorage openFileStorageForRead(const String& path, const String& what)
 // ---------------------------------------------------------------------------------------------
 // Tracks
 
-bool Tracks::observed(int f, int p) const
+Point2f Tracks::at(int f, int p) const
 {
-    return isFinite2(tracks.at<Point2f>(f, p));
+    const int i = find(f, p);
+    if (i >= 0)
+        return uv_[i];
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    return Point2f(nan, nan);
 }
 
-int Tracks::observationCount(int p) const
+int Tracks::find(int f, int p) const
 {
-    int n = 0;
-    for (int f = 0; f < tracks.rows; f++)
-        n += observed(f, p) ? 1 : 0;
-    return n;
+    const auto b = frame_.begin() + trackStart_[p], e = frame_.begin() + trackStart_[p + 1];
+    const auto it = std::lower_bound(b, e, f);
+    return it != e && *it == f ? (int)(it - frame_.begin()) : -1;
+}
+
+void Tracks::buildFrameIndex()
+{
+    const int N = observations();
+    frameStart_.assign(frames_ + 1, 0);
+    for (int i = 0; i < N; i++)
+        frameStart_[frame_[i] + 1]++;
+    for (int f = 0; f < frames_; f++)
+        frameStart_[f + 1] += frameStart_[f];
+    byFrame_.resize(N);
+    std::vector<int> fill(frameStart_.begin(), frameStart_.end() - 1);
+    // Observations are by point, so each frame's list comes out by increasing point.
+    for (int i = 0; i < N; i++)
+        byFrame_[fill[frame_[i]]++] = i;
+}
+
+Tracks Tracks::fromDense(Size imageSize, const Mat& denseIn, const String& what)
+{
+    if (denseIn.empty())
+        CV_Error(Error::StsBadSize, what + ": key 'tracks' is empty");
+    Mat dense = denseIn;
+    if (dense.type() != CV_32FC2)
+    {
+        if (dense.channels() == 2 && dense.depth() == CV_64F)
+            dense.convertTo(dense, CV_32FC2);
+        else
+            CV_Error(Error::StsUnsupportedFormat, what + ": key 'tracks' must be a 2f "
+                     "(CV_32FC2) matrix, got " + typeToString(dense.type()));
+    }
+    const int F = dense.rows, P = dense.cols;
+    Tracks t;
+    t.imageSize = imageSize;
+    t.frames_ = F;
+    t.trackStart_.assign(P + 1, 0);
+    for (int f = 0; f < F; f++)
+    {
+        const Point2f* row = dense.ptr<Point2f>(f);
+        for (int p = 0; p < P; p++)
+        {
+            const bool nx = std::isnan(row[p].x), ny = std::isnan(row[p].y);
+            if (nx && ny)
+                continue;
+            if (nx != ny)
+                CV_Error(Error::StsBadArg, what + cv::format(": key 'tracks' (%d, %d) has one "
+                         "coordinate NaN and the other not", f, p));
+            if (!isFinite2(row[p]))
+                CV_Error(Error::StsBadArg, what + cv::format(": key 'tracks' (%d, %d) is not "
+                         "finite (only a NaN pair may mark an unobserved entry)", f, p));
+            t.trackStart_[p + 1]++;
+        }
+    }
+    for (int p = 0; p < P; p++)
+        t.trackStart_[p + 1] += t.trackStart_[p];
+    const int N = t.trackStart_[P];
+    t.frame_.resize(N);
+    t.point_.resize(N);
+    t.uv_.resize(N);
+    std::vector<int> fill(t.trackStart_.begin(), t.trackStart_.end() - 1);
+    for (int f = 0; f < F; f++)
+    {
+        const Point2f* row = dense.ptr<Point2f>(f);
+        for (int p = 0; p < P; p++)
+            if (!std::isnan(row[p].x))
+            {
+                const int i = fill[p]++;
+                t.frame_[i] = f;
+                t.point_[i] = p;
+                t.uv_[i] = row[p];
+            }
+    }
+    t.buildFrameIndex();
+    return t;
+}
+
+Tracks Tracks::fromObservations(Size imageSize, int frames, int points, const Mat& indexIn,
+                                const Mat& uvIn, const String& what)
+{
+    if (frames < 0 || points < 0)
+        CV_Error(Error::StsBadArg, what + cv::format(": frames = %d and points = %d must not be "
+                 "negative", frames, points));
+    Mat index = indexIn, uvm = uvIn;
+    if (index.empty() != uvm.empty())
+        CV_Error(Error::StsBadSize, what + ": key 'obs_index' and key 'obs_uv' must both be "
+                 "empty or both hold the observations");
+    if (!index.empty())
+    {
+        if (index.type() != CV_32SC1 || index.cols != 2)
+            CV_Error(Error::StsBadSize, what + ": key 'obs_index' must be an N x 2 32S matrix "
+                     "(frame, point), got " + cv::format("%dx%d ", index.rows, index.cols) +
+                     typeToString(index.type()));
+        if (uvm.depth() == CV_64F && uvm.channels() == 1)
+            uvm.convertTo(uvm, CV_32F);
+        if (uvm.type() != CV_32FC1 || uvm.cols != 2)
+            CV_Error(Error::StsBadSize, what + ": key 'obs_uv' must be an N x 2 32F matrix "
+                     "(u, v), got " + cv::format("%dx%d ", uvm.rows, uvm.cols) +
+                     typeToString(uvm.type()));
+        if (uvm.rows != index.rows)
+            CV_Error(Error::StsBadSize, what + cv::format(": key 'obs_index' has %d rows but key "
+                     "'obs_uv' has %d", index.rows, uvm.rows));
+        if (!index.isContinuous())
+            index = index.clone();
+        if (!uvm.isContinuous())
+            uvm = uvm.clone();
+    }
+    const int N = index.rows;
+    const int* ix = index.empty() ? nullptr : index.ptr<int>();
+    const float* q = uvm.empty() ? nullptr : uvm.ptr<float>();
+    for (int i = 0; i < N; i++)
+    {
+        const int f = ix[2 * i], p = ix[2 * i + 1];
+        if (f < 0 || f >= frames || p < 0 || p >= points)
+            CV_Error(Error::StsOutOfRange, what + cv::format(": key 'obs_index' row %d = (%d, %d) "
+                     "is outside frames [0, %d) or points [0, %d)", i, f, p, frames, points));
+        if (!std::isfinite(q[2 * i]) || !std::isfinite(q[2 * i + 1]))
+            CV_Error(Error::StsBadArg, what + cv::format(": key 'obs_uv' row %d (frame %d, "
+                     "point %d) is not finite", i, f, p));
+    }
+    // By point, then frame (the file's order when it follows the contract: then a no-op).
+    std::vector<int> order(N);
+    std::iota(order.begin(), order.end(), 0);
+    bool sorted = true;
+    for (int i = 1; i < N && sorted; i++)
+        sorted = std::make_pair(ix[2 * i - 1], ix[2 * i - 2]) <
+                 std::make_pair(ix[2 * i + 1], ix[2 * i]);
+    if (!sorted)
+        std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+            return std::make_pair(ix[2 * a + 1], ix[2 * a]) <
+                   std::make_pair(ix[2 * b + 1], ix[2 * b]);
+        });
+    Tracks t;
+    t.imageSize = imageSize;
+    t.frames_ = frames;
+    t.trackStart_.assign(points + 1, 0);
+    t.frame_.resize(N);
+    t.point_.resize(N);
+    t.uv_.resize(N);
+    for (int k = 0; k < N; k++)
+    {
+        const int i = order[k];
+        t.frame_[k] = ix[2 * i];
+        t.point_[k] = ix[2 * i + 1];
+        t.uv_[k] = Point2f(q[2 * i], q[2 * i + 1]);
+        t.trackStart_[t.point_[k] + 1]++;
+        if (k > 0 && t.point_[k] == t.point_[k - 1] && t.frame_[k] == t.frame_[k - 1])
+            CV_Error(Error::StsBadArg, what + cv::format(": key 'obs_index' holds (frame %d, "
+                     "point %d) twice", t.frame_[k], t.point_[k]));
+    }
+    for (int p = 0; p < points; p++)
+        t.trackStart_[p + 1] += t.trackStart_[p];
+    t.buildFrameIndex();
+    return t;
+}
+
+Tracks Tracks::mapped(const std::function<Point2f(int, int, const Point2f&)>& fn,
+                      Size newImageSize) const
+{
+    Tracks out = *this;
+    out.imageSize = newImageSize;
+    std::atomic<bool> dropped(false);
+    parallel_for_(Range(0, observations()), [&](const Range& r) {
+        for (int i = r.start; i < r.end; i++)
+        {
+            out.uv_[i] = fn(frame_[i], point_[i], uv_[i]);
+            if (!isFinite2(out.uv_[i]))
+                dropped = true;
+        }
+    });
+    if (!dropped)
+        return out;
+    Tracks kept;
+    kept.imageSize = newImageSize;
+    kept.frames_ = frames_;
+    kept.trackStart_.assign(trackStart_.size(), 0);
+    for (int i = 0; i < observations(); i++)
+        if (isFinite2(out.uv_[i]))
+        {
+            kept.frame_.push_back(frame_[i]);
+            kept.point_.push_back(point_[i]);
+            kept.uv_.push_back(out.uv_[i]);
+            kept.trackStart_[point_[i] + 1]++;
+        }
+    for (int p = 0; p < points(); p++)
+        kept.trackStart_[p + 1] += kept.trackStart_[p];
+    kept.buildFrameIndex();
+    return kept;
+}
+
+Mat Tracks::dense(const std::vector<int>& framesIn, const std::vector<int>& pointsIn) const
+{
+    std::vector<int> rows = framesIn, cols = pointsIn;
+    if (rows.empty())
+    {
+        rows.resize(frames_);
+        std::iota(rows.begin(), rows.end(), 0);
+    }
+    if (cols.empty())
+    {
+        cols.resize(points());
+        std::iota(cols.begin(), cols.end(), 0);
+    }
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    Mat m((int)rows.size(), (int)cols.size(), CV_32FC2, Scalar::all(nan));
+    for (int c = 0; c < (int)cols.size(); c++)
+        for (int r = 0; r < (int)rows.size(); r++)
+        {
+            const int i = find(rows[r], cols[c]);
+            if (i >= 0)
+                m.at<Point2f>(r, c) = uv_[i];
+        }
+    return m;
 }
 
 void Tracks::validate(const String& what) const
@@ -141,58 +357,158 @@ void Tracks::validate(const String& what) const
     const String where = what.empty() ? String("tracks") : what;
     if (imageSize.width <= 0 || imageSize.height <= 0)
         CV_Error(Error::StsBadArg, where + ": image_size must be positive");
-    if (tracks.empty())
+    if (frames_ <= 0 || points() <= 0)
         CV_Error(Error::StsBadSize, where + ": key 'tracks' is empty");
-    if (tracks.type() != CV_32FC2)
-        CV_Error(Error::StsUnsupportedFormat, where + ": key 'tracks' must be a CV_32FC2 (2f) "
-                 "matrix, got " + typeToString(tracks.type()));
-    for (int f = 0; f < tracks.rows; f++)
-    {
-        const Point2f* row = tracks.ptr<Point2f>(f);
-        for (int p = 0; p < tracks.cols; p++)
+    const int N = observations();
+    if (trackStart_[0] != 0 || trackStart_[points()] != N || (int)point_.size() != N ||
+        (int)uv_.size() != N || (int)frameStart_.size() != frames_ + 1 ||
+        (int)byFrame_.size() != N)
+        CV_Error(Error::StsInternal, where + ": inconsistent observation index");
+    for (int p = 0; p < points(); p++)
+        for (int i = trackStart_[p]; i < trackStart_[p + 1]; i++)
         {
-            const bool fx = std::isfinite(row[p].x), fy = std::isfinite(row[p].y);
-            if (fx != fy)
-                CV_Error(Error::StsBadArg, where + cv::format(": key 'tracks' (%d, %d) has one "
-                         "coordinate NaN and the other not", f, p));
+            if (point_[i] != p || frame_[i] < 0 || frame_[i] >= frames_ ||
+                (i > trackStart_[p] && frame_[i] <= frame_[i - 1]))
+                CV_Error(Error::StsInternal, where + ": inconsistent observation index");
+            if (!isFinite2(uv_[i]))
+                CV_Error(Error::StsBadArg, where + cv::format(": observation of track %d in frame "
+                         "%d is not finite", p, frame_[i]));
         }
+}
+
+Tracks::Builder::Builder(Size imageSize, int frames) : size_(imageSize), frames_(frames)
+{
+    start_.push_back(0);
+}
+
+int Tracks::Builder::addTrack()
+{
+    start_.push_back((int)frame_.size());
+    return (int)start_.size() - 2;
+}
+
+void Tracks::Builder::add(int f, const Point2f& uv)
+{
+    CV_Assert(start_.size() >= 2);
+    frame_.push_back(f);
+    uv_.push_back(uv);
+    start_.back() = (int)frame_.size();
+}
+
+Tracks Tracks::Builder::build(const String& what)
+{
+    const int N = (int)frame_.size(), P = (int)start_.size() - 1;
+    Mat index(N, 2, CV_32S), uv(N, 2, CV_32F);
+    for (int p = 0; p < P; p++)
+        for (int i = start_[p]; i < start_[p + 1]; i++)
+        {
+            index.at<int>(i, 0) = frame_[i];
+            index.at<int>(i, 1) = p;
+            uv.at<float>(i, 0) = uv_[i].x;
+            uv.at<float>(i, 1) = uv_[i].y;
+        }
+    return Tracks::fromObservations(size_, frames_, P, index, uv, what);
+}
+
+namespace {
+
+// Observations below this count are written as text (readable), above in base64.
+const int kBase64Observations = 1024;
+// Every value of the dense matrix takes at least this many bytes of text (".Nan" or a number,
+// and a separator: YAML, JSON and XML alike), so a cell at least twice it.
+const size_t kMinDenseCellBytes = 8;
+
+void fillTracks(FileStorage& storage, const Tracks& tracks, TracksForm form)
+{
+    storage << "image_size" << (Mat_<int>(1, 2) << tracks.imageSize.width,
+                                tracks.imageSize.height);
+    storage << "frames" << tracks.frames();
+    storage << "points" << tracks.points();
+    if (form == TRACKS_DENSE)
+    {
+        storage << "tracks" << tracks.dense();
+        return;
     }
+    const int N = tracks.observations();
+    Mat index(N, 2, CV_32S), uv(N, 2, CV_32F);
+    for (int i = 0; i < N; i++)
+    {
+        index.at<int>(i, 0) = tracks.frameOf(i);
+        index.at<int>(i, 1) = tracks.pointOf(i);
+        uv.at<float>(i, 0) = tracks.uv(i).x;
+        uv.at<float>(i, 1) = tracks.uv(i).y;
+    }
+    storage << "obs_index" << index;
+    storage << "obs_uv" << uv;
+}
+
+int formFlags(const Tracks& tracks, TracksForm form)
+{
+    return form == TRACKS_SPARSE && tracks.observations() >= kBase64Observations
+               ? (int)FileStorage::BASE64 : 0;
+}
+
+} // namespace
+
+size_t tracksFileBytes(const String& path, const Tracks& tracks, TracksForm form)
+{
+    CV_Assert(form == TRACKS_DENSE || form == TRACKS_SPARSE);
+    tracks.validate(path);
+    return detail::storageText([&](FileStorage& s) { fillTracks(s, tracks, form); }, path,
+                               formFlags(tracks, form)).size();
 }
 
 Tracks readTracks(const String& path)
 {
     FileStorage storage = detail::openFileStorageForRead(path);
     FileNode root = storage.root();
-    Tracks t;
-    t.imageSize = readImageSize(root, path);
+    const Size imageSize = readImageSize(root, path);
     const int frames = readIntKey(root, "frames", path);
     const int points = readIntKey(root, "points", path);
-    t.tracks = readMatKey(root, "tracks", path);
-    if (t.tracks.type() != CV_32FC2)
+    if (frames <= 0 || points <= 0)
+        CV_Error(Error::StsBadArg, path + cv::format(": frames = %d and points = %d must be "
+                 "positive", frames, points));
+    const FileNode denseNode = root["tracks"], indexNode = root["obs_index"];
+    const bool dense = !denseNode.empty() && !denseNode.isNone();
+    const bool sparse = !indexNode.empty() && !indexNode.isNone();
+    if (dense && sparse)
+        CV_Error(Error::StsParseError, path + ": holds both key 'tracks' (dense form) and key "
+                 "'obs_index' (sparse form); one only");
+    Tracks t;
+    if (sparse || (!dense && !root["obs_uv"].empty()))
     {
-        if (t.tracks.channels() == 2 && t.tracks.depth() == CV_64F)
-            t.tracks.convertTo(t.tracks, CV_32FC2);
-        else
-            CV_Error(Error::StsUnsupportedFormat, path + ": key 'tracks' must be a 2f "
-                     "(CV_32FC2) matrix, got " + typeToString(t.tracks.type()));
+        const Mat index = readMatKey(root, "obs_index", path);
+        const Mat uv = readMatKey(root, "obs_uv", path);
+        t = Tracks::fromObservations(imageSize, frames, points, index, uv, path);
     }
-    if (t.tracks.rows != frames || t.tracks.cols != points)
-        CV_Error(Error::StsBadSize, path + cv::format(": key 'tracks' is %dx%d but frames = %d "
-                 "and points = %d", t.tracks.rows, t.tracks.cols, frames, points));
+    else
+    {
+        const Mat m = readMatKey(root, "tracks", path);
+        if (m.rows != frames || m.cols != points)
+            CV_Error(Error::StsBadSize, path + cv::format(": key 'tracks' is %dx%d but frames = "
+                     "%d and points = %d", m.rows, m.cols, frames, points));
+        t = Tracks::fromDense(imageSize, m, path);
+    }
     t.validate(path);
     return t;
 }
 
-void writeTracks(const String& path, const Tracks& tracks)
+void writeTracks(const String& path, const Tracks& tracks, TracksForm form)
 {
     tracks.validate(path);
-    detail::writeStorageAtomically(path, [&](FileStorage& storage) {
-        storage << "image_size" << (Mat_<int>(1, 2) << tracks.imageSize.width,
-                                    tracks.imageSize.height);
-        storage << "frames" << tracks.frames();
-        storage << "points" << tracks.points();
-        storage << "tracks" << tracks.tracks;
-    });
+    if (form == TRACKS_SMALLER)
+    {
+        // The sparse text is linear in the observations; the dense one is made only when it can
+        // be the smaller, i.e. when F x P is within a constant of the sparse text.
+        const size_t sparse = tracksFileBytes(path, tracks, TRACKS_SPARSE);
+        const double cells = (double)tracks.frames() * tracks.points();
+        form = tracks.observations() > 0 &&
+                       (cells * kMinDenseCellBytes > (double)sparse ||
+                        sparse < tracksFileBytes(path, tracks, TRACKS_DENSE))
+                   ? TRACKS_SPARSE : TRACKS_DENSE;
+    }
+    detail::writeStorageAtomically(path, [&](FileStorage& s) { fillTracks(s, tracks, form); },
+                                   formFlags(tracks, form));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -19,9 +19,15 @@ std::vector<std::vector<uint64_t>> visibilitySets(const Tracks& tracks,
     std::vector<std::vector<uint64_t>> sets(F, std::vector<uint64_t>(words, 0));
     parallel_for_(Range(0, F), [&](const Range& r) {
         for (int f = r.start; f < r.end; ++f)
-            for (int p = 0; p < P; ++p)
-                if ((objectTracks.empty() || objectTracks[p]) && tracks.observed(f, p))
+        {
+            const Range obs = tracks.frame(f);
+            for (int k = obs.start; k < obs.end; ++k)
+            {
+                const int p = tracks.pointOf(tracks.byFrame(k));
+                if (objectTracks.empty() || objectTracks[p])
                     sets[f][p / 64] |= uint64_t(1) << (p % 64);
+            }
+        }
     });
     return sets;
 }
@@ -44,8 +50,8 @@ double jaccardDistance(const std::vector<uint64_t>& a, const std::vector<uint64_
 
 void checkTracks(const Tracks& tracks, const char* what)
 {
-    if (tracks.tracks.empty() || tracks.tracks.type() != CV_32FC2)
-        CV_Error(Error::StsBadArg, format("%s: tracks are empty or not CV_32FC2", what));
+    if (tracks.frames() <= 0 || tracks.points() <= 0)
+        CV_Error(Error::StsBadArg, format("%s: tracks are empty", what));
 }
 
 void checkObjectTracks(const Tracks& tracks, const std::vector<uchar>& objectTracks,

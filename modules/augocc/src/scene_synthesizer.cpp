@@ -1087,10 +1087,8 @@ void makeTracks(const SceneSynthesizer::Params& p, const SceneModel& m, const Ma
                 noisy.at<Point2f>(f, col) = Point2f(nan, nan);
             }
     }
-    scene.tracks.imageSize = size;
-    scene.tracks.tracks = noisy;
-    scene.cleanTracks.imageSize = size;
-    scene.cleanTracks.tracks = clean;
+    scene.tracks = Tracks::fromDense(size, noisy, "SceneSynthesizer: tracks");
+    scene.cleanTracks = Tracks::fromDense(size, clean, "SceneSynthesizer: clean tracks");
 }
 
 // ---------------------------------------------------------------------------------------------

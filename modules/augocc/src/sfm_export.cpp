@@ -53,6 +53,10 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
                  rec.points.rows, tracks.points()));
     if (!(orthoDistanceRatio > 1))
         CV_Error(Error::StsBadArg, "writeColmapModel: orthoDistanceRatio must be > 1");
+    for (const Camera& cam : rec.cameras)
+        if (cam.frame >= tracks.frames())
+            CV_Error(Error::StsBadSize, cv::format("reconstruction has a camera of frame %d, "
+                     "tracks %d frames", cam.frame, tracks.frames()));
     const Mat colors = checkColors(colorsArg, rec.points.rows, "writeColmapModel");
     // Lenses: COLMAP's OPENCV (k1, k2, p1, p2) and FULL_OPENCV (k3..k6 too) are OpenCV's own
     // model of the normalised point; thin prism and tilt terms have no COLMAP model.
@@ -107,23 +111,23 @@ void writeColmapModel(const String& dir, const Reconstruction& rec, const Tracks
             out << id << ' ' << q.w() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' '
                 << cam.t[0] << ' ' << cam.t[1] << ' ' << cam.t[2] << ' ' << id << ' '
                 << cv::format("%04d.png", cam.frame) << '\n';
-            const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
+            const Range obs = tracks.frame(cam.frame);
             int idx = 0;
             bool firstPt = true;
-            for (int p = 0; p < P; p++)
+            for (int k = obs.start; k < obs.end; k++)
             {
-                if (!std::isfinite(row[p].x))
-                    continue;
+                const int p = tracks.pointOf(tracks.byFrame(k));
+                const Point2f o = tracks.uv(tracks.byFrame(k));
                 const bool has3d = rec.hasPoint(p);
                 if (!firstPt)
                     out << ' ';
                 firstPt = false;
-                out << row[p].x + 0.5 << ' ' << row[p].y + 0.5 << ' ' << (has3d ? p + 1 : -1);
+                out << o.x + 0.5 << ' ' << o.y + 0.5 << ' ' << (has3d ? p + 1 : -1);
                 if (has3d)
                 {
                     pointTrack[p].emplace_back(id, idx);
                     const Point2d q2 = cam.project(rec.point(p));
-                    errSum[p] += std::hypot(q2.x - row[p].x, q2.y - row[p].y);
+                    errSum[p] += std::hypot(q2.x - o.x, q2.y - o.y);
                 }
                 idx++;
             }

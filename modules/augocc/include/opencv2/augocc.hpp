@@ -46,9 +46,10 @@ Every type, function and file of the module follows these; headers do not restat
   pixels; angles are in degrees unless the name or the comment says radians.
 - Frame indices are 0-based, counted in the input sequence as decoded (frame i is the i-th image
   of a video, of a folder sorted by name or of a printf pattern).
-- Tracks: element (f, p) of cv::augocc::Tracks::tracks is track p in frame f, NaN where it is
-  not observed; row p of cv::augocc::Reconstruction::points is the 3D point of track p, a row of
-  NaN where the track has none.
+- Tracks: cv::augocc::Tracks::at(f, p) is track p in frame f, NaN where it is not observed (the
+  tracks are stored sparse, one entry per observation); row p of
+  cv::augocc::Reconstruction::points is the 3D point of track p, a row of NaN where the track
+  has none.
 */
 
 #include "opencv2/augocc/camera.hpp"

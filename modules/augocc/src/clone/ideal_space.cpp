@@ -69,24 +69,11 @@ Tracks IdealSpace::tracks(const Tracks& t) const
 {
     if (!active())
         return t;
-    Tracks out;
-    out.imageSize = view->idealSize();
-    out.tracks = t.tracks.clone();
     const Ptr<const LensView> v = view;
-    Mat& m = out.tracks;
-    parallel_for_(Range(0, m.rows), [&](const Range& r) {
-        for (int f = r.start; f < r.end; f++)
-        {
-            Point2f* row = m.ptr<Point2f>(f);
-            for (int p = 0; p < m.cols; p++)
-                if (std::isfinite(row[p].x) && std::isfinite(row[p].y))
-                {
-                    const Point2d q = v->frameToIdeal(Point2d(row[p].x, row[p].y));
-                    row[p] = Point2f((float)q.x, (float)q.y);
-                }
-        }
-    });
-    return out;
+    return t.mapped([&](int, int, const Point2f& q) {
+        const Point2d r = v->frameToIdeal(Point2d(q.x, q.y));
+        return Point2f((float)r.x, (float)r.y);
+    }, view->idealSize());
 }
 
 IdealMasks::IdealMasks(CloneSetImpl& set, const IdealSpace& space) : set_(set)

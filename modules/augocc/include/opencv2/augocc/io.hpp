@@ -25,29 +25,102 @@ namespace augocc {
 //! @addtogroup augocc
 //! @{
 
-/** @brief 2D feature tracks: the measurement matrix of the factorization.
+/** @brief 2D feature tracks: the measurement matrix of the factorization, stored sparse.
 
-`tracks` is F x P CV_32FC2, (u, v) of track p in frame f, both NaN where not observed.
+Track p observed in frame f at (u, v) is one observation; memory is linear in the observations
+(about 20 bytes each), never F x P. Observations are numbered i = 0 .. observations() - 1 by
+track, then frame (the order of the sparse form of tracks.yml); track(p) is the range of track p's
+observations (frames increasing) and frame(f) the range k of frame f's observations, byFrame(k)
+their numbers (points increasing). Every observation is finite; unobserved entries do not exist.
+Build tracks with fromDense() (small shots, tests), fromObservations() or Builder.
 @sa @ref augocc_conventions_units "Units and indices"
 */
 struct CV_EXPORTS Tracks
 {
     Size imageSize;  //!< size of the frames, pixels
-    Mat tracks;      //!< F x P CV_32FC2: (u, v) of track p in frame f, pixels; NaN: not observed
 
-    //! Number of frames F (rows of `tracks`).
-    int frames() const { return tracks.rows; }
-    //! Number of tracks P (columns of `tracks`).
-    int points() const { return tracks.cols; }
-    //! True when track p is observed (finite) in frame f.
-    bool observed(int f, int p) const;
+    /** @brief Tracks from the dense F x P matrix (CV_32FC2, or CV_64FC2 converted); a NaN pair
+    is "not observed". Throws StsBadArg naming `what` and the entry when one coordinate is NaN
+    and the other not, or a value is infinite; StsBadSize when the matrix is empty;
+    StsUnsupportedFormat for another type. */
+    static Tracks fromDense(Size imageSize, const Mat& dense, const String& what = "tracks");
+    /** @brief Tracks of F frames and P points from N observations in any order.
+    @param index N x 2 CV_32S (frame, point), or empty. @param uv N x 2 CV_32F (u, v) (CV_64F is
+    converted), or empty. Throws cv::Exception naming `what` on a bad shape or type, a frame or
+    point out of range, a repeated (frame, point) or a non-finite position. */
+    static Tracks fromObservations(Size imageSize, int frames, int points, const Mat& index,
+                                   const Mat& uv, const String& what = "tracks");
+
+    //! Number of frames F.
+    int frames() const { return frames_; }
+    //! Number of tracks P.
+    int points() const { return trackStart_.empty() ? 0 : (int)trackStart_.size() - 1; }
+    //! Number of observations N.
+    int observations() const { return (int)frame_.size(); }
+    //! True when track p is observed in frame f (binary search in the track).
+    bool observed(int f, int p) const { return find(f, p) >= 0; }
     //! Observation of track p in frame f (NaN if unobserved).
-    Point2f at(int f, int p) const { return tracks.at<Point2f>(f, p); }
+    Point2f at(int f, int p) const;
     //! Number of frames in which track p is observed.
-    int observationCount(int p) const;
-    //! Throws when the matrix type, the size or a value is inconsistent.
-    //! @param what names the source (file, key) in the message.
+    int observationCount(int p) const { return trackStart_[p + 1] - trackStart_[p]; }
+    //! Number of tracks observed in frame f.
+    int frameObservationCount(int f) const { return frameStart_[f + 1] - frameStart_[f]; }
+    //! Number of observation i of track p in frame f, or -1.
+    int find(int f, int p) const;
+
+    //! Observations of track p: i in [start, end), frames increasing.
+    Range track(int p) const { return Range(trackStart_[p], trackStart_[p + 1]); }
+    //! Positions k of frame f's observations: byFrame(k) for k in [start, end), points increasing.
+    Range frame(int f) const { return Range(frameStart_[f], frameStart_[f + 1]); }
+    //! Number of the k-th observation in frame order.
+    int byFrame(int k) const { return byFrame_[k]; }
+    //! Frame of observation i.
+    int frameOf(int i) const { return frame_[i]; }
+    //! Track (point) of observation i.
+    int pointOf(int i) const { return point_[i]; }
+    //! Position (u, v) of observation i, pixels.
+    Point2f uv(int i) const { return uv_[i]; }
+
+    /** @brief The same tracks with every position mapped by `fn(frame, point, uv)` (in parallel:
+    `fn` must be thread-safe); observations mapped to a non-finite position are dropped. */
+    Tracks mapped(const std::function<Point2f(int, int, const Point2f&)>& fn,
+                  Size newImageSize) const;
+    /** @brief The dense block of the given frames (rows) and points (columns), CV_32FC2, NaN
+    where unobserved; empty lists = every frame / every point. For small blocks only (tests,
+    displays): the whole shot's block is F x P. */
+    Mat dense(const std::vector<int>& frames = std::vector<int>(),
+              const std::vector<int>& points = std::vector<int>()) const;
+    //! Throws naming `what` when the size, the index or a value is inconsistent.
     void validate(const String& what = String()) const;
+
+    /** @brief Builds tracks one track at a time (the tracker, the synthesizer). */
+    class CV_EXPORTS Builder
+    {
+    public:
+        Builder(Size imageSize, int frames);
+        //! Starts a new track; returns its number p.
+        int addTrack();
+        //! Adds the observation of the current track in frame f (increasing f within a track).
+        void add(int f, const Point2f& uv);
+        //! The tracks (throws like fromObservations when an observation is bad).
+        Tracks build(const String& what = "tracks");
+    private:
+        Size size_;
+        int frames_;
+        std::vector<int> start_, frame_;
+        std::vector<Point2f> uv_;
+    };
+
+private:
+    void buildFrameIndex();
+
+    int frames_ = 0;
+    std::vector<int> trackStart_;   // P + 1 offsets into the observations
+    std::vector<int> frame_;        // N, by track then frame
+    std::vector<int> point_;        // N
+    std::vector<Point2f> uv_;       // N
+    std::vector<int> frameStart_;   // F + 1 offsets into byFrame_
+    std::vector<int> byFrame_;      // N observation numbers, by frame then point
 };
 
 /** @brief Cameras and 3D points. Row p of `points` belongs to column p of the tracks it came from;
@@ -124,10 +197,28 @@ typedef std::map<int, Mat> FrameMasks;
 //! Masks of several objects: object name -> its frames.
 typedef std::map<String, FrameMasks> ObjectMasks;
 
-//! @brief Reads tracks.yml (also .yml.gz / .json). Throws naming the file and key on error.
+//! Form of tracks.yml (contract: the dense `tracks` matrix or the sparse `obs_index`/`obs_uv`).
+enum TracksForm
+{
+    TRACKS_SMALLER = 0,  //!< whichever file is smaller (the default)
+    TRACKS_DENSE = 1,    //!< the F x P `tracks` matrix
+    TRACKS_SPARSE = 2    //!< `obs_index` and `obs_uv`, base64 (FileStorage) when large
+};
+
+/** @brief Reads tracks.yml in either form (also .yml.gz / .json). Throws naming the file and the
+key on error: a missing key, both forms at once, a bad type or shape, a frame or point out of
+range, a repeated observation, a non-finite position (dense: one coordinate NaN, or infinite). */
 CV_EXPORTS Tracks readTracks(const String& path);
-//! @brief Writes tracks.yml atomically.
-CV_EXPORTS void writeTracks(const String& path, const Tracks& tracks);
+/** @brief Writes tracks.yml atomically in `form`. TRACKS_SMALLER writes the sparse form when its
+text is smaller than the dense one's (compared before any compression), else the dense form,
+byte for byte as TRACKS_DENSE writes it; deciding costs memory linear in the observations (the
+dense text is made only when F x P is within a constant of the sparse text). */
+CV_EXPORTS void writeTracks(const String& path, const Tracks& tracks,
+                            TracksForm form = TRACKS_SMALLER);
+/** @brief Bytes of the text of tracks.yml in `form` (TRACKS_DENSE or TRACKS_SPARSE; before any
+compression); `path` picks the format (YAML, JSON, XML) as in writeTracks(). For the size rule
+and the perf scripts. */
+CV_EXPORTS size_t tracksFileBytes(const String& path, const Tracks& tracks, TracksForm form);
 
 //! @brief Reads reconstruction.yml. Throws naming the file and key on error.
 CV_EXPORTS Reconstruction readReconstruction(const String& path);
