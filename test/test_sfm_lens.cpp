@@ -201,24 +201,27 @@ does. Returns the count of observations moved by more than 1 px. */
 int dragTracks(HandheldProblem& p, double pxPerFrame, uint64 seed)
 {
     RNG rng(seed);
+    // Offset of every observation, by (frame, point); most are zero.
+    Mat offset(p.tracks.frames(), p.tracks.points(), CV_32FC2, Scalar::all(0));
     int moved = 0;
     for (int i = 0; i < p.tracks.points(); i += 8)
     {
-        std::vector<int> fs;
-        for (int f = 0; f < p.tracks.frames(); f++)
-            if (p.tracks.observed(f, i))
-                fs.push_back(f);
-        if (fs.size() < 30)
+        const Range seen = p.tracks.track(i);
+        const int n = seen.size();
+        if (n < 30)
             continue;
         const double a = rng.uniform(0.0, 2 * CV_PI);
-        for (size_t k = fs.size() / 2; k < fs.size(); k++)
+        for (int k = n / 2; k < n; k++)
         {
-            const double d = pxPerFrame * (double)(k - fs.size() / 2 + 1);
-            p.tracks.tracks.at<Point2f>(fs[k], i) += Point2f((float)(d * std::cos(a)),
-                                                             (float)(d * std::sin(a)));
+            const double d = pxPerFrame * (double)(k - n / 2 + 1);
+            offset.at<Point2f>(p.tracks.frameOf(seen.start + k), i) =
+                Point2f((float)(d * std::cos(a)), (float)(d * std::sin(a)));
             moved += d > 1.0 ? 1 : 0;
         }
     }
+    p.tracks = p.tracks.mapped([&](int f, int pt, const Point2f& uv) {
+        return uv + offset.at<Point2f>(f, pt);
+    }, p.tracks.imageSize);
     return moved;
 }
 

@@ -933,49 +933,52 @@ above); points left with fewer than kMinExplainedViews explained observations be
 are. Returns the count of observations dropped; `thresholdPx` gets the threshold used. */
 int dropUnexplained(const Tracks& tracks, Reconstruction& rec, Tracks& kept, double& thresholdPx)
 {
-    const int P = tracks.points();
-    std::vector<float> e;
+    const int P = tracks.points(), N = tracks.observations();
+    std::vector<const Camera*> cameraOf(tracks.frames(), nullptr);
     for (const Camera& cam : rec.cameras)
-    {
-        if (cam.frame < 0 || cam.frame >= tracks.frames())
-            continue;
-        const Point2f* row = tracks.tracks.ptr<Point2f>(cam.frame);
-        for (int p = 0; p < P; p++)
-            if (std::isfinite(row[p].x) && rec.hasPoint(p))
-                e.push_back((float)cv::norm(cam.project(rec.point(p)) -
-                                            Point2d(row[p].x, row[p].y)));
-    }
-    kept = tracks;
-    kept.tracks = tracks.tracks.clone();
+        if (cam.frame >= 0 && cam.frame < tracks.frames())
+            cameraOf[cam.frame] = &cam;
+    // Residual of every observation judged (NaN: not judged), by observation index.
+    std::vector<float> e(N, std::numeric_limits<float>::quiet_NaN());
+    parallel_for_(Range(0, N), [&](const Range& r) {
+        for (int i = r.start; i < r.end; i++)
+        {
+            const Camera* cam = cameraOf[tracks.frameOf(i)];
+            const int p = tracks.pointOf(i);
+            if (cam && rec.hasPoint(p))
+                e[i] = (float)cv::norm(cam->project(rec.point(p)) - Point2d(tracks.uv(i)));
+        }
+    });
+    std::vector<float> judged;
+    for (float x : e)
+        if (!std::isnan(x))
+            judged.push_back(x);
     thresholdPx = 0;
-    if (e.empty())
+    if (judged.empty())
+    {
+        kept = tracks;
         return 0;
-    std::vector<float> sorted = e;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    }
+    std::nth_element(judged.begin(), judged.begin() + judged.size() / 2, judged.end());
     thresholdPx = std::max(kUnexplainedFloorPx,
-                           kUnexplainedOverMedian * sorted[sorted.size() / 2]);
+                           kUnexplainedOverMedian * judged[judged.size() / 2]);
     std::vector<int> explained(P, 0);
     int dropped = 0;
-    size_t k = 0;
-    for (const Camera& cam : rec.cameras)
+    for (int i = 0; i < N; i++)
     {
-        if (cam.frame < 0 || cam.frame >= tracks.frames())
+        if (std::isnan(e[i]))
             continue;
-        Point2f* row = kept.tracks.ptr<Point2f>(cam.frame);
-        for (int p = 0; p < P; p++)
-        {
-            if (!std::isfinite(row[p].x) || !rec.hasPoint(p))
-                continue;
-            if (e[k++] > thresholdPx)
-            {
-                row[p] = Point2f(std::numeric_limits<float>::quiet_NaN(),
-                                 std::numeric_limits<float>::quiet_NaN());
-                dropped++;
-            }
-            else
-                explained[p]++;
-        }
+        if (e[i] > thresholdPx)
+            dropped++;
+        else
+            explained[tracks.pointOf(i)]++;
     }
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const double thr = thresholdPx;
+    kept = tracks.mapped([&](int f, int p, const Point2f& uv) {
+        const float x = e[tracks.find(f, p)];
+        return x > thr ? Point2f(nan, nan) : uv;
+    }, tracks.imageSize);
     for (int p = 0; p < P; p++)
         if (rec.hasPoint(p) && explained[p] < kMinExplainedViews)
             rec.points.row(p).setTo(std::numeric_limits<double>::quiet_NaN());
