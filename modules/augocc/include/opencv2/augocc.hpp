@@ -51,6 +51,7 @@ Every type, function and file of the module follows these; headers do not restat
   NaN where the track has none.
 */
 
+#include "opencv2/augocc/progress.hpp"
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/lens.hpp"
 #include "opencv2/augocc/io.hpp"

@@ -9,6 +9,7 @@
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/io.hpp"
 #include "opencv2/augocc/factorization_sfm.hpp"
+#include "opencv2/augocc/progress.hpp"
 
 namespace cv {
 namespace augocc {
@@ -167,6 +168,8 @@ only when focal + k1 beat the focal alone), so that a
     double lensInlierPx = 3.0;
     //! Self-calibration: largest relative standard deviation of the focal that is trusted.
     double maxFocalRelStd = 0.01;
+    //! Progress (stage "sfm"): each bundle adjustment is a step counting its iterations.
+    ProgressCallback progress;
 };
 
 //! What recoverCameras() did.
