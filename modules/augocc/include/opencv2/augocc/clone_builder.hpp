@@ -299,8 +299,8 @@ CV_EXPORTS void renderMattes(const CloneSet& clones, const Reconstruction& rec,
 
 /** @brief Writes the contract's mattes folder `DIR/<object>/%04d.png` for every frame of `rec`,
 and, when `depthDir` is not empty, `depthDir/<object>/%04d.tiff` (32-bit float camera-space z,
-+inf off the clone). Both folders are written atomically.
-@param progress optional (stage "matte"): frames rendered. */
++inf off the clone). Both folders are written atomically. `progress` (optional, stage "matte"):
+the frames rendered, as renderMattes() reports them. */
 CV_EXPORTS void writeMattes(const String& dir, const CloneSet& clones, const Reconstruction& rec,
                             const String& depthDir = String(),
                             const ProgressCallback& progress = ProgressCallback());
