@@ -313,5 +313,48 @@ TEST(Augocc_RunDriver, resume_after_kill_during_clone)
         EXPECT_NE('.', e.path().filename().string()[0]) << e.path();
 }
 
+TEST(Augocc_RunDriver, results_do_not_depend_on_progress)
+{
+    // The same sfm and clones with a callback set as without; the callback hears the stages.
+    SceneSynthesizer::Params sp;
+    sp.frames = 12;
+    sp.imageSize = Size(240, 180);
+    sp.numKeyFrames = 3;
+    SyntheticScene scene;
+    SceneSynthesizer::create(sp)->synthesize(scene);
+    std::map<String, int> heard;
+    const ProgressCallback cb = [&](const Progress& p) { heard[p.stage]++; };
+    SfmOptions plain, reported;
+    reported.progress = cb;
+    const Reconstruction a = recoverCameras(scene.tracks, plain);
+    const Reconstruction b = recoverCameras(scene.tracks, reported);
+    ASSERT_EQ(a.cameras.size(), b.cameras.size());
+    for (size_t i = 0; i < a.cameras.size(); i++)
+    {
+        EXPECT_EQ(0, cv::norm(Mat(a.cameras[i].R), Mat(b.cameras[i].R), NORM_INF)) << i;
+        EXPECT_EQ(0, cv::norm(Mat(a.cameras[i].t), Mat(b.cameras[i].t), NORM_INF)) << i;
+    }
+    CloneBuilder::Params cp;
+    const Ptr<CloneSet> ca = CloneBuilder::create(cp)->build(a, scene.keyFrameMasks,
+                                                             &scene.tracks);
+    cp.progress = cb;
+    const Ptr<CloneSet> cb2 = CloneBuilder::create(cp)->build(a, scene.keyFrameMasks,
+                                                              &scene.tracks);
+    ObjectMasks ma, mb;
+    renderMattes(*ca, a, ma);
+    renderMattes(*cb2, a, mb, nullptr, cb);
+    ASSERT_EQ(ma.size(), mb.size());
+    for (const auto& o : ma)
+    {
+        EXPECT_EQ(ca->voxelCount(o.first), cb2->voxelCount(o.first)) << o.first;
+        for (const auto& f : o.second)
+            EXPECT_EQ(0, cv::norm(f.second, mb[o.first][f.first], NORM_INF))
+                << o.first << " frame " << f.first;
+    }
+    EXPECT_GT(heard["sfm"], 0);
+    EXPECT_GT(heard["clone"], 0);
+    EXPECT_GT(heard["matte"], 0);
+}
+
 } // namespace
 } // namespace opencv_test
