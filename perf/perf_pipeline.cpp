@@ -109,6 +109,7 @@ void Augocc_Pipeline_run(benchmark::State& state)
         o.masksDir = in.masks;
         o.scenePath = in.scene;
         o.outDir = (fs::path(in.dir) / "out").string();
+        o.force = true;  // every iteration runs every stage (no resume from the last one)
         const RunResult r = runPipeline(o);
         for (const auto& s : r.stageSeconds)
             stage[s.first] += s.second;

@@ -378,5 +378,51 @@ TEST_F(Augocc_CliRun, bad_input_masks_do_not_match_video)
     EXPECT_TRUE(badInputRejected(runArgs(d.video, late, d.scene), {"late", "video.avi"}, out_));
 }
 
+TEST_F(Augocc_CliRun, bad_input_empty_mask_before_tracking)
+{
+    // An all-black key-frame mask: once found by the clone stage only, after track and sfm,
+    // with tracks.yml and reconstruction.yml left behind. Now before any stage.
+    const CliData& d = cliData();
+    ObjectMasks m = readMasks(d.masks, d.size);
+    ASSERT_FALSE(m.empty());
+    auto& firstObject = *m.begin();
+    ASSERT_FALSE(firstObject.second.empty());
+    const int frame = firstObject.second.begin()->first;
+    firstObject.second.begin()->second.setTo(Scalar(0));
+    const String masks = tempDir("empty_masks");
+    writeMasks(masks, m);
+    EXPECT_TRUE(badInputRejected(runArgs(d.frames, masks, d.scene),
+                                 {firstObject.first, cv::format("%04d.png", frame), "empty"},
+                                 out_));
+    // All white: the same, before any stage.
+    firstObject.second.begin()->second.setTo(Scalar(255));
+    const String full = tempDir("full_masks");
+    writeMasks(full, m);
+    EXPECT_TRUE(badInputRejected(runArgs(d.frames, full, d.scene),
+                                 {cv::format("%04d.png", frame), "whole frame"}, out_));
+}
+
+TEST_F(Augocc_CliRun, bad_input_scene_anchor_without_masks)
+{
+    // The scene places an object against a clone the masks do not make.
+    const CliData& d = cliData();
+    const String in = tempDir("in");
+    writeText(in + "/anchor.yml", "%YAML:1.0\n---\nobjects:\n  - { name: dome, shape: dome, "
+                                  "behind: no_such_object }\n");
+    EXPECT_TRUE(badInputRejected(runArgs(d.frames, d.masks, in + "/anchor.yml"),
+                                 {"anchor.yml", "no_such_object"}, out_));
+}
+
+TEST_F(Augocc_CliRun, bad_input_options_before_tracking)
+{
+    const CliData& d = cliData();
+    EXPECT_TRUE(badInputRejected(runArgs(d.frames, d.masks, d.scene) + " --model weird",
+                                 {"--model", "weird"}, out_));
+    EXPECT_TRUE(badInputRejected(runArgs(d.frames, d.masks, d.scene) + " --voxel-pixels 0",
+                                 {"--voxel-pixels"}, out_));
+    EXPECT_TRUE(badInputRejected(runArgs(d.frames, d.masks, d.scene) + " --threads -1",
+                                 {"--threads"}, out_));
+}
+
 } // namespace
 } // namespace opencv_test

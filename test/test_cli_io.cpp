@@ -133,6 +133,14 @@ bool readsBack(const String& file, const String& reference)
             readReconstruction(file);
         else if (name == "clones.yml.gz")
             CloneSet::load(file);
+        else if (name.size() > 13 && name.compare(name.size() - 13, 13, ".manifest.yml") == 0)
+        {
+            // run's resume manifests: they record modification times, so they differ from the
+            // roomy run's; complete means a stage and the output's signature are there.
+            FileStorage m(file, FileStorage::READ);
+            return m.isOpened() && !((String)m["stage"]).empty() &&
+                   !((String)m["output"]).empty();
+        }
         else if (fs::path(file).extension() == ".png")
         {
             const Mat a = imread(file, IMREAD_UNCHANGED), b = imread(reference, IMREAD_UNCHANGED);

@@ -12,31 +12,111 @@
 
 namespace augocc_cli {
 
-Progress::Progress(const Globals& g, const std::string& stage, int total)
-    : enabled_(!g.quiet && isatty(fileno(stderr))), stage_(stage), total_(total),
-      start_(std::chrono::steady_clock::now())
+ProgressPrinter::ProgressPrinter(const Globals& g)
+    : enabled_(!g.quiet), tty_(isatty(fileno(stderr)) != 0), start_(Clock::now()),
+      printed_(start_)
 {
-    update(0);
 }
 
-void Progress::update(int done)
+ProgressPrinter::~ProgressPrinter()
+{
+    finish();
+}
+
+cv::augocc::ProgressCallback ProgressPrinter::callback()
+{
+    return [this](const cv::augocc::Progress& p) { report(p); };
+}
+
+void ProgressPrinter::report(const std::string& stage, long long done, long long total,
+                             const std::string& unit)
+{
+    cv::augocc::Progress p;
+    p.stage = stage;
+    p.done = done;
+    p.total = total;
+    p.unit = unit;
+    report(p);
+}
+
+void ProgressPrinter::report(const cv::augocc::Progress& p)
 {
     if (!enabled_)
         return;
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double eta = done > 0 ? elapsed * (total_ - done) / done : 0.0;
-    std::fprintf(stderr, "\r%-10s %5d/%-5d  %6.1f s elapsed  ETA %6.1f s", stage_.c_str(), done,
-                 total_, elapsed, eta);
+    const Clock::time_point now = Clock::now();
+    const std::string key = p.stage + "/" + p.step;
+    const bool newStage = p.stage != last_.stage;
+    if (key != key_)
+    {
+        // The previous stage's last state, then the new step from its start (a new step of
+        // the same stage does not print: sfm has a step per bundle adjustment).
+        if (pending_ && newStage)
+            print(last_);
+        if (tty_ && newStage && width_ > 0)
+        {
+            std::fputc('\n', stderr);
+            width_ = 0;
+        }
+        key_ = key;
+        start_ = now;
+    }
+    last_ = p;
+    pending_ = true;
+    const double since = std::chrono::duration<double>(now - printed_).count();
+    const bool finished = p.total > 0 && p.done >= p.total;
+    if (tty_ ? (since >= 0.1 || finished || newStage)
+             : (newStage || since >= kLogIntervalSeconds))
+        print(p);
+}
+
+void ProgressPrinter::print(const cv::augocc::Progress& p)
+{
+    const Clock::time_point now = Clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    std::string line = p.stage;
+    if (!p.step.empty())
+        line += ": " + p.step;
+    line = cv::format("%-32s", line.c_str());
+    if (p.total > 0)
+    {
+        line += cv::format(" %lld/%lld %s (%3.0f%%)", (long long)p.done, (long long)p.total,
+                           p.unit.c_str(), 100.0 * (double)p.done / (double)p.total);
+        if (p.done > 0 && p.done < p.total)
+            line += cv::format("  %.1f s, about %.1f s left", elapsed,
+                               elapsed * (double)(p.total - p.done) / (double)p.done);
+        else
+            line += cv::format("  %.1f s", elapsed);
+    }
+    else
+        line += cv::format(" %lld %s  %.1f s", (long long)p.done, p.unit.c_str(), elapsed);
+    if (!p.message.empty())
+        line += "  " + p.message;
+    if (tty_)
+    {
+        const size_t w = line.size();
+        if (w < width_)
+            line += std::string(width_ - w, ' ');
+        width_ = w;
+        std::fprintf(stderr, "\r%s", line.c_str());
+    }
+    else
+        std::fprintf(stderr, "%s\n", line.c_str());
     std::fflush(stderr);
+    printed_ = now;
+    pending_ = false;
 }
 
-void Progress::finish()
+void ProgressPrinter::finish()
 {
     if (!enabled_)
         return;
-    update(total_);
-    std::fprintf(stderr, "\n");
+    if (pending_)
+        print(last_);
+    if (tty_ && width_ > 0)
+        std::fputc('\n', stderr);
+    width_ = 0;
+    key_.clear();
+    last_ = cv::augocc::Progress();
 }
 
 void info(const Globals& g, const std::string& line)

@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/camera_refiner.hpp"
+#include "opencv2/augocc/progress.hpp"
 
 namespace augocc_cli {
 
@@ -26,20 +27,40 @@ struct UsageError : std::runtime_error
     using std::runtime_error::runtime_error;
 };
 
-/** @brief One progress line on stderr (done/total, elapsed, ETA), redrawn in place, shown only
-when stderr is a terminal and --quiet is not given. */
-class Progress
+/** @brief Renders the library's Progress reports on stderr, with the time elapsed in the current
+step and an estimate of the time left. On a terminal: one line redrawn in place (`\r`, at most
+ten times a second). Otherwise (a log file, CI): plain lines, the first report of each stage,
+then one every `kLogIntervalSeconds` at most, and each stage's last report, like ffmpeg or COLMAP
+logs. --quiet: nothing. */
+class ProgressPrinter
 {
 public:
-    Progress(const Globals& g, const std::string& stage, int total);
-    void update(int done);
+    //! Seconds between two lines of a stage when stderr is not a terminal.
+    static constexpr double kLogIntervalSeconds = 2.0;
+
+    explicit ProgressPrinter(const Globals& g);
+    ~ProgressPrinter();
+    //! The callback to give the library (it refers to this printer).
+    cv::augocc::ProgressCallback callback();
+    //! One report.
+    void report(const cv::augocc::Progress& p);
+    //! One report of a stage without steps (the CLI's own loops).
+    void report(const std::string& stage, long long done, long long total,
+                const std::string& unit);
+    //! Prints what is pending (the last report) and ends the terminal line.
     void finish();
 
 private:
-    bool enabled_;
-    std::string stage_;
-    int total_;
-    std::chrono::steady_clock::time_point start_;
+    typedef std::chrono::steady_clock Clock;
+    void print(const cv::augocc::Progress& p);
+
+    bool enabled_, tty_;
+    std::string key_;           // stage + step of the last report
+    Clock::time_point start_;   // of the current step
+    Clock::time_point printed_; // last line printed
+    cv::augocc::Progress last_;
+    bool pending_ = false;      // last_ not printed yet
+    size_t width_ = 0;          // of the terminal line drawn
 };
 
 //! Prints an informational line on stdout unless --quiet.

@@ -83,7 +83,8 @@ void runClone(const CloneOptions& o, const Globals& g)
                 frames[f] = img;
         }
     }
-    Progress progress(g, "clone", 1);
+    ProgressPrinter progress(g);
+    p.progress = progress.callback();
     cv::Ptr<CloneBuilder> builder = CloneBuilder::create(p);
     cv::Ptr<CloneSet> clones = builder->build(rec, masks, o.tracks.empty() ? nullptr : &tracks);
     if (!frames.empty())

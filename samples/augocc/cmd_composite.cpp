@@ -45,15 +45,10 @@ void runComposite(const Globals& g, const CompositeCliOptions& o)
     opt.depthDir = o.depth;
     opt.virtualLayerDir = o.layer;
     opt.reconstructionName = o.reconstruction;
-    std::unique_ptr<Progress> progress;
-    opt.progress = [&](int done, int total) {
-        if (!progress)
-            progress.reset(new Progress(g, "composite", total));
-        progress->update(done);
-    };
+    ProgressPrinter progress(g);
+    opt.progress = progress.callback();
     const int n = compositeSequence(o.input, rec, *clones, meshes, o.out, opt);
-    if (progress)
-        progress->finish();
+    progress.finish();
     info(g, "composited " + std::to_string(n) + " frames into " + o.out);
 }
 

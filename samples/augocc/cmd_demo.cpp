@@ -10,10 +10,6 @@ using namespace cv::augocc;
 
 namespace augocc_cli {
 
-std::function<void(const String&, int, int)> stageProgress(const Globals& g,
-                                                           std::shared_ptr<Progress>& current,
-                                                           std::shared_ptr<std::string>& stage);
-
 void registerDemo(CLI::App& app, Globals& g)
 {
     auto outDir = std::make_shared<std::string>("augocc_demo");
@@ -61,12 +57,10 @@ void registerDemo(CLI::App& app, Globals& g)
                              "handheld) or ignored");
         o.outDir = *outDir;
         o.photoRefine = !*noPhoto;
-        std::shared_ptr<Progress> current;
-        auto stage = std::make_shared<std::string>();
-        o.progress = stageProgress(g, current, stage);
+        ProgressPrinter progress(g);
+        o.progress = progress.callback();
         const DemoResult r = runDemo(o);
-        if (current)
-            current->finish();
+        progress.finish();
         for (const auto& s : r.run.stageSeconds)
             info(g, cv::format("%-10s %7.2f s", s.first.c_str(), s.second));
         info(g, "composite:     " + r.compositePath);

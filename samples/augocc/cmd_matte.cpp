@@ -39,8 +39,8 @@ void runMatte(const MatteOptions& o, const Globals& g)
         rec.cameras = chosen;
     }
     const cv::Ptr<CloneSet> clones = CloneSet::load(o.clones);
-    Progress progress(g, "matte", (int)rec.cameras.size());
-    writeMattes(o.out, *clones, rec, o.depth);
+    ProgressPrinter progress(g);
+    writeMattes(o.out, *clones, rec, o.depth, progress.callback());
     progress.finish();
     info(g, cv::format("mattes of %d objects in %d frames written to %s",
                        (int)clones->objectNames().size(), (int)rec.cameras.size(), o.out.c_str()));

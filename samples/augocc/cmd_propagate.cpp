@@ -78,7 +78,7 @@ void runPropagate(const Options& opt, const Globals& g)
 
     std::set<std::string> wanted(opt.objects.begin(), opt.objects.end());
     ObjectMasks out;
-    Progress progress(g, "propagate", int(frames.size()));
+    ProgressPrinter progress(g);
     int done = 0;
     SilhouetteEditor::Params params;
     for (int f : frames)
@@ -114,7 +114,7 @@ void runPropagate(const Options& opt, const Globals& g)
             else
                 out[p.first];
         }
-        progress.update(++done);
+        progress.report("propagate", ++done, (long long)frames.size(), "frames");
     }
     progress.finish();
     for (const std::string& name : wanted)

@@ -2,30 +2,12 @@
 
 #include "cli_common.hpp"
 
-#include <map>
 #include "opencv2/augocc.hpp"
 
 using namespace cv;
 using namespace cv::augocc;
 
 namespace augocc_cli {
-
-//! Progress lines per stage for the pipeline's callback (one line per stage on a terminal).
-std::function<void(const String&, int, int)> stageProgress(const Globals& g,
-                                                           std::shared_ptr<Progress>& current,
-                                                           std::shared_ptr<std::string>& stage)
-{
-    return [&g, &current, &stage](const String& name, int done, int total) {
-        if (!current || *stage != name)
-        {
-            if (current)
-                current->finish();
-            current = std::make_shared<Progress>(g, name, std::max(total, 1));
-            *stage = name;
-        }
-        current->update(done);
-    };
-}
 
 namespace {
 
@@ -38,6 +20,11 @@ struct RunCliOptions
     std::string calibration;
     double focal = 0;
     bool refineIntrinsics = false;
+    std::string model = RunOptions().model;
+    double voxelPixels = RunOptions().voxelPixels;
+    bool noFreeSpace = false;
+    int threads = 0;
+    bool force = false;
 };
 
 void runRun(const Globals& g, const RunCliOptions& o)
@@ -45,6 +32,11 @@ void runRun(const Globals& g, const RunCliOptions& o)
     requireFile("--masks", o.masks);
     if (!o.scene.empty())
         requireFile("--scene", o.scene);
+    if (o.threads < 0)
+        throw UsageError(cv::format("--threads %d: must be at least 1 (0: every core)",
+                                    o.threads));
+    if (o.threads > 0)
+        cv::setNumThreads(o.threads);
     RunOptions ro;
     ro.input = o.input;
     ro.masksDir = o.masks;
@@ -57,15 +49,23 @@ void runRun(const Globals& g, const RunCliOptions& o)
     ro.calibrationPath = o.calibration;
     ro.focal = o.focal;
     ro.refineIntrinsics = o.refineIntrinsics;
-    std::shared_ptr<Progress> current;
-    auto stage = std::make_shared<std::string>();
-    ro.progress = stageProgress(g, current, stage);
+    ro.model = o.model;
+    ro.voxelPixels = o.voxelPixels;
+    ro.freeSpace = !o.noFreeSpace;
+    ro.force = o.force;
+    ProgressPrinter progress(g);
+    ro.progress = progress.callback();
     const RunResult r = runPipeline(ro);
-    if (current)
-        current->finish();
+    progress.finish();
     for (const auto& s : r.stageSeconds)
-        info(g, cv::format("%-10s %7.2f s", s.first.c_str(), s.second));
-    info(g, lensLine(r.sfm));
+    {
+        const bool reused =
+            std::find(r.reused.begin(), r.reused.end(), s.first) != r.reused.end();
+        info(g, cv::format("%-10s %7.2f s%s", s.first.c_str(), s.second,
+                           reused ? "  (reused: inputs and options unchanged)" : ""));
+    }
+    if (std::find(r.reused.begin(), r.reused.end(), "sfm") == r.reused.end())
+        info(g, lensLine(r.sfm));
     info(g, "outputs in " + o.outDir + (r.compositePath.empty()
                                             ? " (no --scene: stopped after the mattes)"
                                             : ", composite: " + r.compositePath));
@@ -77,7 +77,7 @@ void registerRun(CLI::App& app, Globals& g)
 {
     auto o = std::make_shared<RunCliOptions>();
     CLI::App* sub = app.add_subcommand("run", "the whole pipeline: track, sfm, clone, matte, "
-                                       "composite");
+                                       "composite (re-runs reuse what is unchanged)");
     sub->add_option("--input", o->input, "video, image folder or printf pattern")->required();
     sub->add_option("--masks", o->masks, "key-frame masks, MASKS/<object>/%04d.png")->required();
     sub->add_option("--scene", o->scene, "scene.yml (without it, run stops after the mattes)");
@@ -93,6 +93,16 @@ void registerRun(CLI::App& app, Globals& g)
     sub->add_option("--focal", o->focal, "known focal length only, pixels")
         ->excludes("--calibration");
     sub->add_flag("--refine-intrinsics", o->refineIntrinsics, "refine the given intrinsics");
+    sub->add_option("--model", o->model, "camera model: scaled_orthographic | perspective | "
+                    "auto (as augocc sfm --model)")->capture_default_str();
+    sub->add_option("--voxel-pixels", o->voxelPixels, "voxel edge in pixels (as augocc clone "
+                    "--voxel-pixels)")->capture_default_str();
+    sub->add_flag("--no-free-space", o->noFreeSpace, "do not carve the free space the tracks "
+                  "show (silhouettes only, the paper's rule)");
+    sub->add_option("--threads", o->threads, "worker threads (default 0: every core; results "
+                    "do not depend on it)");
+    sub->add_flag("--force", o->force, "redo every stage (default: reuse each intermediate "
+                  "whose inputs and options are unchanged, see its .manifest.yml)");
     sub->callback([&g, o]() { runRun(g, *o); });
 }
 

@@ -58,7 +58,8 @@ void registerSfm(CLI::App& app, Globals& g)
         setIntrinsicsOptions(args->calibration, args->focal, args->refineIntrinsics,
                              tracks.imageSize, opt);
         cv::augocc::SfmReport rep;
-        Progress progress(g, "sfm", 1);
+        ProgressPrinter progress(g);
+        opt.progress = progress.callback();
         const cv::augocc::Reconstruction rec = cv::augocc::recoverCameras(tracks, opt, &rep);
         progress.finish();
         cv::augocc::writeReconstruction(args->out, rec);

@@ -136,6 +136,8 @@ void runSynth(const Globals& g, const SynthOptions& o)
     p.exposureDrift = o.exposureDrift;
     p.whiteBalanceDrift = o.whiteBalanceDrift;
     p.videoBitrateMbps = o.bitrate;
+    ProgressPrinter progress(g);
+    p.progress = progress.callback();
     Ptr<SceneSynthesizer> synth;
     try
     {
@@ -173,10 +175,9 @@ void runSynth(const Globals& g, const SynthOptions& o)
     SyntheticScene scene;
     synth->synthesize(scene);
 
-    Progress progress(g, "writing", (int)scene.frames.size());
     // The whole folder is built under a temporary name and renamed into place: a failure leaves
     // no partial DIR (an existing DIR is replaced only on success).
-    writeSyntheticScene(o.out, scene, p, [&progress](int done, int) { progress.update(done); });
+    writeSyntheticScene(o.out, scene, p, progress.callback());
     progress.finish();
     if (!o.contactSheet.empty())
     {

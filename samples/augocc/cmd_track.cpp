@@ -66,10 +66,9 @@ void registerTrack(CLI::App& app, Globals& g)
                              args->mask.c_str(), p.exclusionMask.cols, p.exclusionMask.rows,
                              src->size().width, src->size().height));
         cv::augocc::Tracks tracks;
-        Progress progress(g, "track", std::max(1, src->count()));
-        cv::augocc::FeatureTracker::create(p)->track(src, tracks, [&](int done, int) {
-            progress.update(done);
-        });
+        ProgressPrinter progress(g);
+        p.progress = progress.callback();
+        cv::augocc::FeatureTracker::create(p)->track(src, tracks);
         progress.finish();
         cv::augocc::writeTracks(args->out, tracks);
         int full = 0;

@@ -244,6 +244,7 @@ bool OrthoCameraRefinerImpl::refinePositionZoom(const Tracks& tracks, Reconstruc
     ceres::Solver::Options options;
     fillOptions(options);
     options.linear_solver_ordering.reset(ordering);
+    detail::SolverProgress solverProgress(options, "3F+1 refinement");
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem, &summary);
     if (!solverUsable(summary, "3F+1 refinement") || !(s > 0))
@@ -325,6 +326,7 @@ bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction&
     ceres::Solver::Options options;
     fillOptions(options, true);
     options.linear_solver_ordering.reset(ordering);
+    detail::SolverProgress solverProgress(options, "scaled-orthographic BA");
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem, &summary);
     if (!solverUsable(summary, "scaled-orthographic bundle adjustment"))
@@ -434,6 +436,7 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     ceres::Solver::Options options;
     fillOptions(options, true);
     options.linear_solver_ordering.reset(ordering);
+    detail::SolverProgress solverProgress(options, "perspective BA");
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem, &summary);
     if (!solverUsable(summary, "perspective bundle adjustment") || !std::isfinite(kappa))
@@ -854,6 +857,7 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     if (solve)
     {
         options.linear_solver_ordering.reset(ordering);
+        detail::SolverProgress solverProgress(options, "lens BA");
         ceres::Solver::Summary summary;
         ceres::Solve(options, &problem, &summary);
         if (!solverUsable(summary, "lens bundle adjustment"))
@@ -1250,6 +1254,7 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
     if (!(options.lensInlierPx > 0) || !(options.maxFocalRelStd > 0))
         CV_Error(Error::StsBadArg, "sfm: lensInlierPx and maxFocalRelStd must be positive");
     tracks.validate("tracks");
+    const detail::ProgressScope progressScope(options.progress, "sfm");
     SfmReport rep;
     Reconstruction rec;
     Camera lens;

@@ -294,12 +294,15 @@ public:
                      "at least 2", (int)frames.size()));
         TrackingSession s(params_, frames[0].size());
         for (const Mat& f : frames)
+        {
             s.addFrame(f);
+            detail::reportProgress(params_.progress, "track", "", s.frames(),
+                                   (int64)frames.size(), "frames");
+        }
         out = s.finish();
     }
 
-    void track(const Ptr<FrameSource>& source, Tracks& out,
-               const std::function<void(int, int)>& progress) const CV_OVERRIDE
+    void track(const Ptr<FrameSource>& source, Tracks& out) const CV_OVERRIDE
     {
         if (source.empty())
             CV_Error(Error::StsBadArg, "FeatureTracker: no frame source");
@@ -309,8 +312,8 @@ public:
         while (source->read(frame))
         {
             s.addFrame(frame);
-            if (progress)
-                progress(s.frames(), std::max(total, s.frames()));
+            detail::reportProgress(params_.progress, "track", "", s.frames(),
+                                   std::max(total, s.frames()), "frames");
         }
         if (s.frames() < 2)
             CV_Error(Error::StsBadArg, cv::format("FeatureTracker: the input has %d frame(s); "

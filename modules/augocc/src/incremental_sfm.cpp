@@ -551,6 +551,7 @@ void IncrementalBuilder::bundleAdjust(const std::vector<uchar>& variable, int it
     o.num_threads = 1;
     o.minimizer_progress_to_stdout = false;
     o.logging_type = ceres::SILENT;
+    SolverProgress solverProgress(o, "incremental BA");
     ceres::Solver::Summary summary;
     ceres::Solve(o, &problem, &summary);
     if (!summary.IsSolutionUsable())

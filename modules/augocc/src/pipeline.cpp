@@ -7,8 +7,10 @@
 
 #include "atomic_write.hpp"
 #include "video_out.hpp"
+#include "run_manifest.hpp"
 
 #include <filesystem>
+#include <set>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -212,8 +214,8 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
                 writeImage((fs::path(mattesOut->tmp()) / o).string(),
                            (fs::path(options.mattesDir) / o).string(), name, matte);
             }
-        if (options.progress)
-            options.progress(f - first + 1, end - first);
+        detail::reportProgress(options.progress, "composite", "", f - first + 1, end - first,
+                               "frames");
     }
     if (video)
     {
@@ -264,34 +266,66 @@ RunResult runPipeline(const RunOptions& o)
 {
     if (o.outDir.empty())
         CV_Error(Error::StsBadArg, "no output folder given");
-    auto progress = [&](const String& stage, int done, int total) {
-        if (o.progress)
-            o.progress(stage, done, total);
-    };
     RunResult r;
     StageTimer timer(r);
-    // Bad inputs first, before any work or output: the input, the masks, the scene.
+    // Bad inputs first, before any work or output: the options, the input, the masks, the
+    // scene, the calibration.
+    if (o.model != "auto" && o.model != "scaled_orthographic" && o.model != "perspective")
+        CV_Error(Error::StsBadArg, "--model " + o.model + ": expected scaled_orthographic, "
+                 "perspective or auto");
+    if (!(o.voxelPixels > 0) || !std::isfinite(o.voxelPixels))
+        CV_Error(Error::StsBadArg, cv::format("--voxel-pixels %g: must be positive",
+                                              o.voxelPixels));
+    CloneBuilder::Params cp;
+    cp.voxelPixels = o.voxelPixels;
+    if (!o.freeSpace)
+        cp.freeSpace.minViews = 0;
+    cp.progress = o.progress;
+    Ptr<CloneBuilder> builder = CloneBuilder::create(cp);
     Ptr<FrameSource> src = FrameSource::open(o.input);
     const ObjectMasks masks = readMasks(o.masksDir, src->size());
     if (masks.empty())
         CV_Error(Error::StsBadArg, o.masksDir + ": no object folder with masks");
     const int frameCount = src->count();
     for (const auto& obj : masks)
+    {
+        if (obj.second.empty())
+            CV_Error(Error::StsBadArg, (fs::path(o.masksDir) / obj.first).string() +
+                     ": no key-frame mask");
         for (const auto& fm : obj.second)
+        {
+            const String file = (fs::path(o.masksDir) / obj.first /
+                                 cv::format("%04d.png", fm.first)).string();
             if (fm.first >= frameCount)
-                CV_Error(Error::StsBadArg, (fs::path(o.masksDir) / obj.first /
-                         cv::format("%04d.png", fm.first)).string() + cv::format(": a mask for "
-                         "frame %d but %s has %d frames: they do not belong together", fm.first,
-                         o.input.c_str(), frameCount));
+                CV_Error(Error::StsBadArg, file + cv::format(": a mask for frame %d but %s has "
+                         "%d frames: they do not belong together", fm.first, o.input.c_str(),
+                         frameCount));
+            // CloneBuilder's own checks (after track and sfm), here before them.
+            const int n = countNonZero(fm.second > 127);
+            if (n == 0)
+                CV_Error(Error::StsBadArg, file + ": the silhouette is empty (no pixel above "
+                         "127): draw the object or remove the file");
+            if (n == (int)fm.second.total())
+                CV_Error(Error::StsBadArg, file + ": the silhouette covers the whole frame");
+        }
+    }
     VirtualScene scene;
     if (!o.scenePath.empty())
+    {
         scene = readScene(o.scenePath);
+        for (const SceneObject& so : scene.objects)
+            if (so.placement != SceneObject::PLACE_ABSOLUTE && !masks.count(so.anchor))
+                CV_Error(Error::StsBadArg, o.scenePath + ": object '" + so.name + "' is placed "
+                         "against '" + so.anchor + "', which has no masks in " + o.masksDir);
+    }
     SfmOptions sfm;
     if (!o.calibrationPath.empty())
         sfm.calibration = readCalibration(o.calibrationPath, src->size());
+    sfm.model = o.model;
     sfm.focal = o.focal;
     sfm.refineIntrinsics = o.refineIntrinsics;
     sfm.selfCalibrate = o.selfCalibrate;
+    sfm.progress = o.progress;
     // An output folder made here and still empty when a stage fails goes again. Intermediate
     // files already written stay: each is complete (written atomically) and re-runs by hand.
     struct EmptyDirGuard
@@ -308,69 +342,170 @@ RunResult runPipeline(const RunOptions& o)
         guard.dir = o.outDir;
     detail::createDirectories(o.outDir);
     const fs::path dir(o.outDir);
+    const String tracksPath = (dir / "tracks.yml").string();
+    const String recPath = (dir / "reconstruction.yml").string();
+    const String clonesPath = (dir / "clones.yml.gz").string();
+    const String mattesPath = (dir / "mattes").string();
+    const String compositePath = (dir / "composite.mp4").string();
+
+    // Resume: each stage's manifest names what its output was made from; the next stage's
+    // names that output's signature, so a stage run again invalidates the ones after it.
+    detail::StageManifest mTrack, mSfm, mClone, mMatte, mComposite;
+    const String inputSignature = detail::pathSignature(o.input);  // every frame file: once
+    mTrack.stage = "track";
+    mTrack.signedInput("input", inputSignature);
+    mTrack.option("tracker", "default");
+    const bool trackReused = !o.force && detail::manifestMatches(mTrack, tracksPath);
+    bool tracksLoaded = false;
+    auto loadTracks = [&]() {
+        if (!tracksLoaded)
+            r.tracks = readTracks(tracksPath);
+        tracksLoaded = true;
+    };
 
     timer.start();
-    progress("track", 0, src->count());
-    FeatureTracker::create()->track(src, r.tracks, [&](int d, int t) { progress("track", d, t); });
-    // A video cut short or corrupt mid-stream ends early: found here, before anything is
-    // written, not later as cameras missing for the masks' frames.
-    if (r.tracks.frames() != frameCount)
-        CV_Error(Error::StsParseError, o.input + cv::format(": %d frames decoded of the %d the "
-                 "input declares (cut short or corrupt)", r.tracks.frames(), frameCount));
-    writeTracks((dir / "tracks.yml").string(), r.tracks);
+    if (trackReused)
+        r.reused.push_back("track");
+    else
+    {
+        detail::removeManifest(tracksPath);
+        FeatureTracker::Params tp;
+        tp.progress = o.progress;
+        FeatureTracker::create(tp)->track(src, r.tracks);
+        tracksLoaded = true;
+        // A video cut short or corrupt mid-stream ends early: found here, before anything is
+        // written, not later as cameras missing for the masks' frames.
+        if (r.tracks.frames() != frameCount)
+            CV_Error(Error::StsParseError, o.input + cv::format(": %d frames decoded of the %d "
+                     "the input declares (cut short or corrupt)", r.tracks.frames(),
+                     frameCount));
+        writeTracks(tracksPath, r.tracks);
+        detail::writeManifest(mTrack, tracksPath);
+    }
     timer.stop("track");
 
+    mSfm.stage = "sfm";
+    mSfm.input("tracks", tracksPath);
+    mSfm.input("calibration", o.calibrationPath);
+    mSfm.option("model", o.model);
+    mSfm.option("focal", o.focal);
+    mSfm.option("refine_intrinsics", o.refineIntrinsics ? "1" : "0");
+    mSfm.option("self_calibrate", o.selfCalibrate ? "1" : "0");
     timer.start();
-    progress("sfm", 0, 1);
-    r.reconstruction = recoverCameras(r.tracks, sfm, &r.sfm);
-    writeReconstruction((dir / "reconstruction.yml").string(), r.reconstruction);
-    progress("sfm", 1, 1);
+    if (!o.force && detail::manifestMatches(mSfm, recPath))
+    {
+        r.reconstruction = readReconstruction(recPath);
+        r.reused.push_back("sfm");
+    }
+    else
+    {
+        detail::removeManifest(recPath);
+        loadTracks();
+        r.reconstruction = recoverCameras(r.tracks, sfm, &r.sfm);
+        writeReconstruction(recPath, r.reconstruction);
+        detail::writeManifest(mSfm, recPath);
+    }
     timer.stop("sfm");
 
+    mClone.stage = "clone";
+    mClone.input("reconstruction", recPath);
+    mClone.input("tracks", tracksPath);
+    mClone.input("masks", o.masksDir);
+    mClone.signedInput("input", o.photoRefine ? inputSignature : String("unused"));
+    mClone.option("voxel_pixels", o.voxelPixels);
+    mClone.option("free_space", o.freeSpace ? "1" : "0");
+    mClone.option("photo_refine", o.photoRefine ? "1" : "0");
     timer.start();
-    progress("clone", 0, 1);
-    Ptr<CloneBuilder> builder = CloneBuilder::create();
-    r.clones = builder->build(r.reconstruction, masks, &r.tracks);
-    if (o.photoRefine)
+    if (!o.force && detail::manifestMatches(mClone, clonesPath))
     {
-        // Every frame with a camera (the others stay empty; refine() reads only those).
-        std::vector<Mat> frames(frameCount);
-        src->seek(0);
-        for (int f = 0; f < frameCount; f++)
-        {
-            Mat img;
-            if (!src->read(img))
-                CV_Error(Error::StsParseError, o.input + cv::format(": frame %d cannot be read "
-                         "again for the photo-consistency carving", f));
-            if (r.reconstruction.findCamera(f) >= 0)
-                frames[f] = img;
-        }
-        builder->refine(*r.clones, r.reconstruction, frames);
+        r.clones = CloneSet::load(clonesPath);
+        r.reused.push_back("clone");
     }
-    r.clones->save((dir / "clones.yml.gz").string());
-    progress("clone", 1, 1);
+    else
+    {
+        detail::removeManifest(clonesPath);
+        loadTracks();
+        r.clones = builder->build(r.reconstruction, masks, &r.tracks);
+        if (o.photoRefine)
+        {
+            // Every frame with a camera (the others stay empty; refine() reads only those).
+            std::vector<Mat> frames(frameCount);
+            src->seek(0);
+            for (int f = 0; f < frameCount; f++)
+            {
+                Mat img;
+                if (!src->read(img))
+                    CV_Error(Error::StsParseError, o.input + cv::format(": frame %d cannot be "
+                             "read again for the photo-consistency carving", f));
+                if (r.reconstruction.findCamera(f) >= 0)
+                    frames[f] = img;
+            }
+            builder->refine(*r.clones, r.reconstruction, frames);
+        }
+        r.clones->save(clonesPath);
+        detail::writeManifest(mClone, clonesPath);
+    }
     timer.stop("clone");
 
+    mMatte.stage = "matte";
+    mMatte.input("clones", clonesPath);
+    mMatte.input("reconstruction", recPath);
     timer.start();
-    progress("matte", 0, 1);
-    writeMattes((dir / "mattes").string(), *r.clones, r.reconstruction);
-    progress("matte", 1, 1);
+    if (!o.force && detail::manifestMatches(mMatte, mattesPath))
+        r.reused.push_back("matte");
+    else
+    {
+        detail::removeManifest(mattesPath);
+        writeMattes(mattesPath, *r.clones, r.reconstruction, String(), o.progress);
+        detail::writeManifest(mMatte, mattesPath);
+    }
     timer.stop("matte");
 
     if (!o.scenePath.empty())
     {
+        mComposite.stage = "composite";
+        mComposite.input("scene", o.scenePath);
+        // The meshes' folders: the mesh files and what they refer to (materials, textures).
+        std::set<String> meshDirs;
+        for (const SceneObject& so : scene.objects)
+            if (!so.meshFile.empty())
+                meshDirs.insert((fs::path(o.scenePath).parent_path() / so.meshFile)
+                                    .parent_path().string());
+        for (const String& d : meshDirs)
+        {
+            // Files of the folder only (not below: it may hold this run's outputs).
+            std::error_code ec;
+            std::vector<String> files;
+            for (const auto& e : fs::directory_iterator(d.empty() ? "." : d, ec))
+                if (e.is_regular_file(ec))
+                    files.push_back(e.path().string());
+            std::sort(files.begin(), files.end());
+            for (const String& f : files)
+                mComposite.input("mesh folder file " + f, f);
+        }
+        mComposite.signedInput("input", inputSignature);
+        mComposite.input("clones", clonesPath);
+        mComposite.input("reconstruction", recPath);
+        mComposite.option("supersample", o.supersample);
+        mComposite.option("antialias_virtual", o.antialiasVirtual ? "1" : "0");
         timer.start();
         r.virtualObjects = placeScene(scene, r.reconstruction, r.clones.get());
-        CompositeOptions co;
-        co.supersample = o.supersample;
-        co.antialiasVirtual = o.antialiasVirtual;
-        co.firstFrame = r.reconstruction.cameras.front().frame;
-        co.endFrame = r.reconstruction.cameras.back().frame + 1;
-        co.progress = [&](int d, int t) { progress("composite", d, t); };
-        r.compositePath = (dir / "composite.mp4").string();
-        progress("composite", 0, co.endFrame - co.firstFrame);
-        compositeSequence(o.input, r.reconstruction, *r.clones, r.virtualObjects,
-                          r.compositePath, co);
+        r.compositePath = compositePath;
+        if (!o.force && detail::manifestMatches(mComposite, compositePath))
+            r.reused.push_back("composite");
+        else
+        {
+            detail::removeManifest(compositePath);
+            CompositeOptions co;
+            co.supersample = o.supersample;
+            co.antialiasVirtual = o.antialiasVirtual;
+            co.firstFrame = r.reconstruction.cameras.front().frame;
+            co.endFrame = r.reconstruction.cameras.back().frame + 1;
+            co.progress = o.progress;
+            compositeSequence(o.input, r.reconstruction, *r.clones, r.virtualObjects,
+                              r.compositePath, co);
+            detail::writeManifest(mComposite, compositePath);
+        }
         timer.stop("composite");
     }
     guard.dir.clear();
@@ -454,13 +589,10 @@ DemoResult runDemo(const DemoOptions& o)
     sp.exposureDrift = o.exposureDrift;
     sp.whiteBalanceDrift = o.whiteBalanceDrift;
     sp.videoBitrateMbps = o.videoBitrateMbps;
+    sp.progress = o.progress;
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
     SyntheticScene scene;
-    if (o.progress)
-        o.progress("synth", 0, 1);
     synth->synthesize(scene);
-    if (o.progress)
-        o.progress("synth", 1, 1);
     // The input: frames as PNG (lossless) or, at a set bit rate, the synthesized data set with
     // its H.264 video (a user's footage) and calibration.yml; key-frame masks, the scene file.
     String framesDir = (dir / "input" / "frames").string();
@@ -468,7 +600,7 @@ DemoResult runDemo(const DemoOptions& o)
     if (o.videoBitrateMbps > 0)
     {
         const String synthDir = (dir / "synth").string();
-        writeSyntheticScene(synthDir, scene, sp);
+        writeSyntheticScene(synthDir, scene, sp, o.progress);
         framesDir = (dir / "synth" / "video.mp4").string();
         masksDir = (dir / "synth" / "input" / "masks").string();
     }
@@ -493,6 +625,7 @@ DemoResult runDemo(const DemoOptions& o)
     ro.outDir = o.outDir;
     ro.progress = o.progress;
     ro.photoRefine = o.photoRefine;
+    ro.force = true;  // the demo measures a whole run, not a resumed one
     if (o.lens == DEMO_LENS_CALIBRATION)
     {
         if (res.calibrationPath.empty())

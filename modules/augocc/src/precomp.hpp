@@ -16,5 +16,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "opencv2/augocc.hpp"
+#include "progress_detail.hpp"
 
 #endif

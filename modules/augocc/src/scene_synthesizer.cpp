@@ -1225,6 +1225,7 @@ public:
             out.whole = &whole[f];
             renderView(gl, m, m.cameras[f], p_.imageSize, p_.frameSupersample, {}, {}, out);
             applyGains(scene.frames[f], frameGains(p_, f));
+            detail::reportProgress(p_.progress, "synth", "render", f + 1, F, "frames");
         }
         // Visible masks from the labels (CPU, parallel over frames: each writes its own masks).
         std::vector<std::vector<Mat>> visible(F, std::vector<Mat>(nObj));

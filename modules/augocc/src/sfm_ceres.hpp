@@ -9,11 +9,13 @@
 #ifndef OPENCV_AUGOCC_SFM_CERES_HPP
 #define OPENCV_AUGOCC_SFM_CERES_HPP
 
+#include <algorithm>
 #include <vector>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <ceres/ceres.h>
 #include <opencv2/core.hpp>
+#include "progress_detail.hpp"
 
 namespace cv {
 namespace augocc {
@@ -371,6 +373,38 @@ inline Matx33d fromQuaternion(const double* xyzw)
             R(r, c) = m(r, c);
     return R;
 }
+
+/** @brief Reports a solve's iterations to the stage's progress (ProgressScope::current()) as
+step `step`, "iterations" of at most Options::max_num_iterations, and the bound when it goes
+(the solve is over). Construct it after the options
+are filled, before ceres::Solve, in the same scope; without a scope it does nothing. Returning
+SOLVER_CONTINUE always, it does not change the solve. */
+class SolverProgress : public ceres::IterationCallback
+{
+public:
+    SolverProgress(ceres::Solver::Options& options, const char* step)
+        : scope_(ProgressScope::current()), step_(step), max_(options.max_num_iterations)
+    {
+        if (scope_)
+            options.callbacks.push_back(this);
+    }
+    //! The solve is over (converged early or not): its step is complete.
+    ~SolverProgress() CV_OVERRIDE
+    {
+        if (scope_)
+            scope_->report(step_, max_, max_, "iterations");
+    }
+    ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) CV_OVERRIDE
+    {
+        scope_->report(step_, std::min<int64>(s.iteration, max_), max_, "iterations");
+        return ceres::SOLVER_CONTINUE;
+    }
+
+private:
+    const ProgressScope* scope_;
+    String step_;
+    int64 max_;
+};
 
 } // namespace detail
 } // namespace augocc

@@ -166,7 +166,7 @@ void writeDepth(const fs::path& dir, const std::vector<Mat>& depth)
 
 void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
                          const SceneSynthesizer::Params& p,
-                         const std::function<void(int done, int total)>& progress)
+                         const ProgressCallback& progress)
 {
     const int F = (int)scene.frames.size();
     if (F == 0)
@@ -196,8 +196,7 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
                                    scene.labels[f]);
                     }
                 });
-                if (progress)
-                    progress(end, F);
+                detail::reportProgress(progress, "synth", "write", end, F, "frames");
             }
             if (p.videoBitrateMbps > 0)
                 writeVideoAtBitrate(tmp / "frames", (tmp / "video.mp4").string(), F,

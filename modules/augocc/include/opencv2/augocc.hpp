@@ -52,9 +52,11 @@ Every type, function and file of the module follows these; headers do not restat
   has none.
 */
 
+#include "opencv2/augocc/progress.hpp"
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/lens.hpp"
 #include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/chunks.hpp"
 #include "opencv2/augocc/mesh.hpp"
 #include "opencv2/augocc/scene_synthesizer.hpp"
 #include "opencv2/augocc/feature_tracker.hpp"

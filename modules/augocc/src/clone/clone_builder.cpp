@@ -35,9 +35,17 @@ void checkMask(const Mat& m, const Reconstruction& rec, const String& object, in
         CV_Error(Error::StsBadArg, where + ": the silhouette covers the whole frame (all white)");
 }
 
+//! Object passes of one build() (step "build" of stage "clone"): one unit per pass and object.
+struct PassProgress
+{
+    const ProgressCallback& cb;
+    int64 done;
+    int64 total;
+};
+
 //! Runs `pass` over every object of `set` in name order and logs what it did to each.
 void runPass(const char* name, int64 (*pass)(ObjectClone&, const PassContext&),
-             CloneSetImpl& set, const PassContext& ctx)
+             CloneSetImpl& set, const PassContext& ctx, PassProgress& progress)
 {
     for (const String& object : set.objectNames())
     {
@@ -46,6 +54,8 @@ void runPass(const char* name, int64 (*pass)(ObjectClone&, const PassContext&),
         CV_UNUSED(name);
         CV_LOG_DEBUG(NULL, cv::format("augocc: clone pass '%s': object '%s': %lld voxels", name,
                                       object.c_str(), (long long)n));
+        detail::reportProgress(progress.cb, "clone", "build", ++progress.done, progress.total,
+                               "passes", String(name) + ": " + object);
     }
 }
 
@@ -171,20 +181,25 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
     ctx.keyFrameMasks = space.active() ? &idealBins : &bins;
     ctx.tracks = tracks && space.active() ? &idealTracks : tracks;
     ctx.inFrame = space.active() ? &space.inFrame : nullptr;
-    runPass("box", passBox, *set, ctx);                 // 1. Steps 1-3: points, box, grid
-    runPass("carve", passCarve, *set, ctx);             // 2. Step 4: silhouette carving
-    runPass("grid growth", passGridGrowth, *set, ctx);  // 3. the hull beyond Step 3's box
-    if (tracks && params_.freeSpace.minViews > 0)
-        runPass("free space", passFreeSpace, *set, ctx);  // 4. what the tracks show empty
+    const bool freeSpace = tracks && params_.freeSpace.minViews > 0;
+    PassProgress pp{params_.progress, 0,
+                    (int64)set->objectNames().size() *
+                        (4 + (freeSpace ? 1 : 0) + (params_.unobserved.enabled ? 1 : 0))};
+    detail::reportProgress(pp.cb, "clone", "build", 0, pp.total, "passes");
+    runPass("box", passBox, *set, ctx, pp);                 // 1. Steps 1-3: points, box, grid
+    runPass("carve", passCarve, *set, ctx, pp);             // 2. Step 4: silhouette carving
+    runPass("grid growth", passGridGrowth, *set, ctx, pp);  // 3. the hull beyond Step 3's box
+    if (freeSpace)
+        runPass("free space", passFreeSpace, *set, ctx, pp);  // 4. what the tracks show empty
     if (params_.unobserved.enabled)
     {
         const ObservedSurfaces observed = observeSurfaces(*set, ctx.rec, params_.unobserved,
                                                           ctx.inFrame);
         ctx.observed = &observed;
-        runPass("unobserved", passUnobserved, *set, ctx);  // 5. what no frame sees
+        runPass("unobserved", passUnobserved, *set, ctx, pp);  // 5. what no frame sees
         ctx.observed = nullptr;
     }
-    runPass("patches", passPatches, *set, ctx);         // 6. Step 5: patch voxels
+    runPass("patches", passPatches, *set, ctx, pp);         // 6. Step 5: patch voxels
     return set;
 }
 
@@ -264,6 +279,13 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
     PassContext ctx(space.active() ? space.rec : rec, set, params_);
     ctx.inFrame = space.active() ? &space.inFrame : nullptr;
     std::map<String, int64> carved;
+    // Step "photo-consistency": one unit per object and round (a round carving nothing ends
+    // the work early: `total` is the bound), one per object re-patched.
+    const int64 nObjects = (int64)set.objectNames().size();
+    const int64 photoTotal = nObjects * (params_.photo.rounds + 1);
+    int64 photoDone = 0;
+    detail::reportProgress(params_.progress, "clone", "photo-consistency", 0, photoTotal,
+                           "passes");
     for (int round = 0; round < params_.photo.rounds; round++)
     {
         // Each round sees the other clones as the last round left them.
@@ -278,6 +300,8 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
             roundCarved += n;
             CV_LOG_DEBUG(NULL, cv::format("augocc: photo-consistency round %d: object '%s': %lld "
                          "voxels carved", round, name.c_str(), (long long)n));
+            detail::reportProgress(params_.progress, "clone", "photo-consistency", ++photoDone,
+                                   photoTotal, "passes", "photo: " + name);
         }
         ctx.photo = nullptr;
         if (roundCarved == 0)
@@ -290,6 +314,8 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
         if (c.second > 0)
             passPatches(set.get(c.first), ctx);  // Step 5 again where the clone changed
     }
+    detail::reportProgress(params_.progress, "clone", "photo-consistency", photoTotal,
+                           photoTotal, "passes");
     return total;
 }
 

@@ -325,25 +325,34 @@ Ptr<CloneSet> CloneSet::load(const String& path)
 }
 
 void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks& mattes,
-                  std::map<String, std::map<int, Mat> >* depth)
+                  std::map<String, std::map<int, Mat> >* depth, const ProgressCallback& progress)
 {
     const std::vector<String> names = clones.objectNames();
     const int nc = (int)rec.cameras.size();
     if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
         CV_Error(Error::StsBadSize, "renderMattes: reconstruction has no image size");
     std::vector<std::vector<Mat> > m(names.size(), std::vector<Mat>(nc)), d = m;
-    parallel_for_(Range(0, nc), [&](const Range& r) {
-        for (int c = r.start; c < r.end; c++)
-            for (size_t o = 0; o < names.size(); o++)
-            {
-                if (depth)
-                    clones.render(names[o], rec.cameras[c].frame, rec.cameras[c], rec.imageSize,
-                                  m[o][c], d[o][c]);
-                else
-                    clones.render(names[o], rec.cameras[c].frame, rec.cameras[c], rec.imageSize,
-                                  m[o][c]);
-            }
-    });
+    // Batches of frames, each in parallel, progress reported between them (from this thread).
+    // Each matte depends on its frame alone: the batching does not change them.
+    const int batch = progress ? std::max(8, 4 * cv::getNumThreads()) : std::max(nc, 1);
+    detail::reportProgress(progress, "matte", "", 0, nc, "frames");
+    for (int b0 = 0; b0 < nc; b0 += batch)
+    {
+        const int b1 = std::min(nc, b0 + batch);
+        parallel_for_(Range(b0, b1), [&](const Range& r) {
+            for (int c = r.start; c < r.end; c++)
+                for (size_t o = 0; o < names.size(); o++)
+                {
+                    if (depth)
+                        clones.render(names[o], rec.cameras[c].frame, rec.cameras[c],
+                                      rec.imageSize, m[o][c], d[o][c]);
+                    else
+                        clones.render(names[o], rec.cameras[c].frame, rec.cameras[c],
+                                      rec.imageSize, m[o][c]);
+                }
+        });
+        detail::reportProgress(progress, "matte", "", b1, nc, "frames");
+    }
     mattes.clear();
     if (depth)
         depth->clear();
@@ -357,11 +366,11 @@ void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks
 }
 
 void writeMattes(const String& dir, const CloneSet& clones, const Reconstruction& rec,
-                 const String& depthDir)
+                 const String& depthDir, const ProgressCallback& progress)
 {
     ObjectMasks mattes;
     std::map<String, std::map<int, Mat> > depth;
-    renderMattes(clones, rec, mattes, depthDir.empty() ? nullptr : &depth);
+    renderMattes(clones, rec, mattes, depthDir.empty() ? nullptr : &depth, progress);
     if (!depthDir.empty())
     {
         namespace fsys = std::filesystem;

@@ -9,6 +9,7 @@
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/io.hpp"
 #include "opencv2/augocc/factorization_sfm.hpp"
+#include "opencv2/augocc/progress.hpp"
 
 namespace cv {
 namespace augocc {
@@ -177,6 +178,8 @@ only when focal + k1 beat the focal alone), so that a
     the count left out stops changing. With self-calibration the lens is chosen again on the
     observations the first choice explains. 0: every observation is used (before issue 15). */
     int explainedRounds = 3;
+    //! Progress (stage "sfm"): each bundle adjustment is a step counting its iterations.
+    ProgressCallback progress;
 };
 
 //! What recoverCameras() did.

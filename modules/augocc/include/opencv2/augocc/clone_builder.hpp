@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/progress.hpp"
 
 namespace cv {
 namespace augocc {
@@ -221,6 +222,9 @@ public:
         FreeSpaceParams freeSpace;    //!< build() with tracks
         UnobservedParams unobserved;  //!< build(), after the free space
         PhotoParams photo;            //!< refine()
+        /** Progress (stage "clone"): build() reports step "build", a unit per pass and
+        object; refine() step "photo-consistency", a unit per object and round. */
+        ProgressCallback progress;
     };
 
     //! Creates a builder; throws as setParams() does on invalid parameters.
@@ -286,16 +290,20 @@ public:
 @param rec the reconstruction (one matte per camera).
 @param mattes output, object -> frame -> CV_8U matte (0 / 255).
 @param depth optional output, object -> frame -> CV_32F camera-space z (+inf off the clone).
+@param progress optional (stage "matte"): frames rendered.
 */
 CV_EXPORTS void renderMattes(const CloneSet& clones, const Reconstruction& rec,
                              ObjectMasks& mattes,
-                             std::map<String, std::map<int, Mat> >* depth = nullptr);
+                             std::map<String, std::map<int, Mat> >* depth = nullptr,
+                             const ProgressCallback& progress = ProgressCallback());
 
 /** @brief Writes the contract's mattes folder `DIR/<object>/%04d.png` for every frame of `rec`,
 and, when `depthDir` is not empty, `depthDir/<object>/%04d.tiff` (32-bit float camera-space z,
-+inf off the clone). Both folders are written atomically. */
++inf off the clone). Both folders are written atomically. `progress` (optional, stage "matte"):
+the frames rendered, as renderMattes() reports them. */
 CV_EXPORTS void writeMattes(const String& dir, const CloneSet& clones, const Reconstruction& rec,
-                            const String& depthDir = String());
+                            const String& depthDir = String(),
+                            const ProgressCallback& progress = ProgressCallback());
 
 //! @}
 

@@ -7,6 +7,7 @@
 #include <functional>
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/progress.hpp"
 
 namespace cv {
 namespace augocc {
@@ -57,6 +58,8 @@ public:
         int border = 4;
         //! Optional CV_8U mask of the frame size, > 127 = no features there.
         Mat exclusionMask;
+        //! Progress (stage "track"): frames tracked, after each frame.
+        ProgressCallback progress;
     };
 
     /** @brief Creates a tracker.
@@ -83,10 +86,8 @@ public:
     reading it from its current position to the end.
     @param source the frames.
     @param out the tracks.
-    @param progress optional, called after each frame with (frames done, frames expected).
     */
-    virtual void track(const Ptr<FrameSource>& source, Tracks& out,
-                       const std::function<void(int, int)>& progress = nullptr) const = 0;
+    virtual void track(const Ptr<FrameSource>& source, Tracks& out) const = 0;
 };
 
 //! @}

@@ -13,6 +13,7 @@
 #include "opencv2/augocc/evaluation.hpp"
 #include "opencv2/augocc/io.hpp"
 #include "opencv2/augocc/mesh.hpp"
+#include "opencv2/augocc/progress.hpp"
 #include "opencv2/augocc/scene_synthesizer.hpp"
 
 /*
@@ -27,9 +28,6 @@ namespace augocc {
 
 //! @addtogroup augocc
 //! @{
-
-//! Progress of a long stage: (done, total).
-typedef std::function<void(int done, int total)> ProgressCallback;
 
 //! Options of compositeSequence().
 struct CV_EXPORTS CompositeOptions
@@ -49,7 +47,7 @@ struct CV_EXPORTS CompositeOptions
     double fps = 0;            //!< output video frame rate (0: the input's)
     //! Light frame (Compositor::Params::lightRotation); default: from estimateGround(rec).
     bool lightFromGround = true;
-    ProgressCallback progress; //!< called after every frame
+    ProgressCallback progress; //!< stage "composite": frames written, after every frame
     //! Name of the reconstruction in error messages (its file, when it comes from one).
     String reconstructionName = "reconstruction";
 };
@@ -97,8 +95,19 @@ struct CV_EXPORTS RunOptions
     bool refineIntrinsics = false;  //!< SfmOptions::refineIntrinsics
     //! SfmOptions::selfCalibrate: false ignores lens distortion when nothing is known.
     bool selfCalibrate = true;
-    //! Stage progress: (stage name, done, total); a stage starts with done = 0.
-    std::function<void(const String& stage, int done, int total)> progress;
+    //! SfmOptions::model: "auto", "scaled_orthographic" or "perspective".
+    String model = SfmOptions().model;
+    //! CloneBuilder::Params::voxelPixels (> 0).
+    double voxelPixels = CloneBuilder::Params().voxelPixels;
+    //! Carve the free space the tracks show (CloneBuilder::Params::freeSpace); false: the
+    //! silhouettes only.
+    bool freeSpace = true;
+    /** Redo every stage. Otherwise a stage whose output in outDir is complete and whose
+    manifest (`<output>.manifest.yml`: the inputs' signatures and the options that matter)
+    matches this run is reused, not run again (see README, "Resume"). */
+    bool force = false;
+    //! Every stage's progress (track, sfm, clone, matte, composite), see Progress.
+    ProgressCallback progress;
 };
 
 //! What runPipeline() produced.
@@ -111,10 +120,21 @@ struct CV_EXPORTS RunResult
     std::vector<Mesh> virtualObjects;   //!< placed, world frame of the reconstruction
     String compositePath;               //!< empty without a scene
     std::vector<std::pair<String, double> > stageSeconds;  //!< wall time per stage
+    //! Stages whose output was reused from an earlier run (RunOptions::force); their
+    //! stageSeconds are the reading. `tracks` stays empty when no stage run needed it, `sfm`
+    //! when sfm was reused.
+    std::vector<String> reused;
 };
 
 /** @brief track -> sfm -> clone -> matte -> composite, writing into outDir: tracks.yml,
-reconstruction.yml, clones.yml.gz, mattes/, composite.mp4 (contract). Throws as the stages do. */
+reconstruction.yml, clones.yml.gz, mattes/, composite.mp4 (contract), each with its manifest.
+
+Every input is checked before the first stage (the frames, every key-frame mask: size, frame
+within the input, neither empty nor the whole frame; the scene with its meshes and the clones it
+is placed against; the calibration; the options): a bad one throws naming it and nothing is
+written. A stage whose output and manifest match the inputs and options is reused (unless
+RunOptions::force); one that runs rewrites its output atomically, then its manifest. Throws as
+the stages do. */
 CV_EXPORTS RunResult runPipeline(const RunOptions& options);
 
 //! DemoOptions::lens.
@@ -161,8 +181,8 @@ struct CV_EXPORTS DemoOptions
     model: what augocc did before issue 15, for comparison). */
     int lens = DEMO_LENS_SELF_CALIBRATE;
     bool photoRefine = true;  //!< RunOptions::photoRefine
-    //! Stage progress: (stage name, done, total), as RunOptions::progress.
-    std::function<void(const String& stage, int done, int total)> progress;
+    //! Progress of the synthesis (stage "synth") and of the run (RunOptions::progress).
+    ProgressCallback progress;
 };
 
 /** @brief The hand-held demo (`augocc demo --model handheld`): street-level hand-held 1280x720

@@ -10,6 +10,7 @@
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/io.hpp"
 #include "opencv2/augocc/mesh.hpp"
+#include "opencv2/augocc/progress.hpp"
 
 namespace cv {
 namespace augocc {
@@ -197,6 +198,8 @@ public:
         `ffmpeg` tool, a phone's 8-16 Mbit/s at 1080p); 0 = OpenCV's VideoWriter with its own
         rate (H.264, else MPEG-4 part 2). */
         double videoBitrateMbps = 0.0;
+        //! Progress of synthesize() (stage "synth"): frames rendered.
+        ProgressCallback progress;
     };
 
     /** @brief The per-frame gains of Params::exposureDrift and Params::whiteBalanceDrift.
@@ -267,12 +270,11 @@ no partial folder; an existing `dir` is replaced on success only.
 @param dir output folder.
 @param scene the data set (from SceneSynthesizer::synthesize).
 @param params the parameters it was made with (recorded in gt/synth.yml).
-@param progress optional callback (frames written, total), called from the calling thread.
+@param progress optional (stage "synth", step "write"): frames written, from the calling thread.
 */
 CV_EXPORTS void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
                                     const SceneSynthesizer::Params& params,
-                                    const std::function<void(int done, int total)>& progress =
-                                        nullptr);
+                                    const ProgressCallback& progress = ProgressCallback());
 
 //! @}
 
