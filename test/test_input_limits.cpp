@@ -127,6 +127,14 @@ TEST(Augocc_InputLimits, regression_deep_nesting)
     fs::remove_all(dir);
 }
 
+TEST(Augocc_InputLimits, regression_fuzz_reconstruction_length_error)
+{
+    // Found by fuzz_reconstruction: OpenCV's YAML parser threw std::length_error out of
+    // FileStorage::open (exit 1, "internal error: basic_string::_M_create").
+    const std::string f = dataFile("fuzz_reconstruction_length_error.yml");
+    EXPECT_TRUE(throwsWith([&] { readReconstruction(f); }, {f, "cannot parse file"}));
+}
+
 TEST(Augocc_InputLimits, regression_duplicate_keys)
 {
     // FileStorage silently kept the first of two 'frames' keys.

@@ -101,6 +101,12 @@ FileStorage openFileStorageForRead(const String& path, const String& what)
     {
         CV_Error(Error::StsParseError, path + ": cannot parse " + what + ": " + e.err);
     }
+    catch (const std::exception& e)
+    {
+        // OpenCV 4.6's parsers also let std::length_error escape (a string key cut short by a
+        // mutation: found by fuzz_reconstruction).
+        CV_Error(Error::StsParseError, path + ": cannot parse " + what + ": " + e.what());
+    }
     if (!storage.isOpened())
         CV_Error(Error::StsParseError, path + ": cannot open or parse " + what + " as a "
                  "FileStorage file");
