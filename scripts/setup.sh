@@ -17,6 +17,7 @@ PACKAGES=(
     xvfb xdotool                          # end-to-end test of the interactive annotate tool
     ffmpeg                                # ffprobe for video checks in tests; ffmpeg for synth --bitrate
     doxygen texlive-base                  # API docs and their test (bibtex for @cite)
+    clang libclang-rt-14-dev              # libFuzzer + ASan/UBSan runtimes of the fuzz tree (fuzz/, scripts/fuzz.sh)
 )
 
 missing=()
