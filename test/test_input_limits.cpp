@@ -135,6 +135,23 @@ TEST(Augocc_InputLimits, regression_fuzz_reconstruction_length_error)
     EXPECT_TRUE(throwsWith([&] { readReconstruction(f); }, {f, "cannot parse file"}));
 }
 
+TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
+{
+    // Found by fuzz_tracks: NUL bytes in a tracks file made FileStorage::open loop for ever.
+    const std::string nul = dataFile("fuzz_tracks_nul_hang.yml");
+    EXPECT_TRUE(throwsWith([&] { readTracks(nul); }, {nul, "NUL byte"}));
+    // Found by fuzz_reconstruction, fuzz_calibration, fuzz_clones: a top level that is not a map
+    // gave OpenCV's "isMap()" assertion (exit 1) from FileNode::operator[].
+    const std::string dir = tempDir("limits_top");
+    const std::string f = dir + "/seq.yml";
+    writeText(f, "%YAML:1.0\n---\n- 1\n- 2\n");
+    for (auto read : std::vector<std::function<void()> >{
+             [&] { readTracks(f); }, [&] { readReconstruction(f); },
+             [&] { readCalibration(f); }, [&] { CloneSet::load(f); }, [&] { readScene(f); }})
+        EXPECT_TRUE(throwsWith(read, {f}));
+    fs::remove_all(dir);
+}
+
 TEST(Augocc_InputLimits, regression_duplicate_keys)
 {
     // FileStorage silently kept the first of two 'frames' keys.

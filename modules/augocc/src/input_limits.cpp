@@ -412,6 +412,12 @@ void checkStorageFile(const String& path, const String& what)
     if (readError)
         CV_Error(Error::StsParseError, path + ": cannot read " + what + " (corrupt compressed "
                  "data)");
+    // OpenCV 4.6's parsers read lines as C strings: a NUL byte made FileStorage::open loop for
+    // ever (found by fuzz_tracks). No FileStorage text holds one.
+    if (std::memchr(text.data(), 0, text.size()))
+        CV_Error(Error::StsParseError, path + cv::format(": %s holds a NUL byte at offset %zu "
+                 "(binary data, not a YAML, JSON or XML text)", what.c_str(),
+                 (size_t)((const char*)std::memchr(text.data(), 0, text.size()) - text.data())));
     const int depth = storageNestingDepth(text.data(), text.size(), kMaxStorageDepth);
     if (depth > kMaxStorageDepth)
         CV_Error(Error::StsOutOfRange, path + cv::format(": %s nests deeper than augocc's limit "

@@ -110,6 +110,10 @@ FileStorage openFileStorageForRead(const String& path, const String& what)
     if (!storage.isOpened())
         CV_Error(Error::StsParseError, path + ": cannot open or parse " + what + " as a "
                  "FileStorage file");
+    // Every augocc file is a map of keys: FileNode::operator[] asserts on anything else (found by
+    // fuzz_reconstruction, fuzz_calibration and fuzz_clones).
+    if (!storage.root().isMap())
+        CV_Error(Error::StsParseError, path + ": " + what + ": the top level is not a map of keys");
     checkDuplicateKeys(storage.root(), path);
     return storage;
 }
