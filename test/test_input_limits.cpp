@@ -256,6 +256,9 @@ TEST(Augocc_InputLimits, regression_mesh_cut_in_header_and_body)
                            {"cut_header.ply", "end_header"}));
     EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("cut_body.ply")); },
                            {"cut_body.ply", "PLY body ends inside vertex 3 of 4"}));
+    // Found by fuzz_mesh: a header with no vertex element made Assimp loop for ever.
+    EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_no_vertex.ply")); },
+                           {"fuzz_mesh_no_vertex.ply", "no 'element vertex'"}));
     // The whole file still loads.
     EXPECT_NO_THROW(loadMeshes(dataFile("tetra.ply")));
 }

@@ -612,7 +612,8 @@ void checkPly(const char* data, size_t size, const String& where)
     const size_t headerLimit = std::min(size, (size_t)1 << 16);
     const char* endTag = nullptr;
     for (size_t i = 0; i + 10 <= headerLimit; i++)
-        if (!std::strncmp(data + i, "end_header", 10) && (i == 0 || data[i - 1] == '\n'))
+        if (!std::strncmp(data + i, "end_header", 10) && (i == 0 || data[i - 1] == '\n') &&
+            (i + 10 == size || data[i + 10] == '\n' || data[i + 10] == '\r'))
         {
             endTag = data + i;
             break;
@@ -690,10 +691,13 @@ void checkPly(const char* data, size_t size, const String& where)
     if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
         CV_Error(Error::StsParseError, where + ": PLY header: format must be ascii, "
                  "binary_little_endian or binary_big_endian");
-    int64 vertices = 0;
+    int64 vertices = -1;
     for (const PlyElement& e : elems)
         if (e.name == "vertex")
             vertices = e.count;
+    // A header without its vertex element made Assimp's PLY loader loop for ever (fuzz_mesh).
+    if (vertices < 0)
+        CV_Error(Error::StsParseError, where + ": PLY header declares no 'element vertex'");
     const char* p = body;
     const char* end = data + size;
     const bool ascii = format == "ascii";
