@@ -19,6 +19,7 @@ PACKAGES=(
     doxygen texlive-base                  # API docs and their test (bibtex for @cite)
     slurm-wlm munge                       # augocc farm's test: a single-node Slurm cluster
     shellcheck                            # the farm's generated job scripts are checked with it
+    clang libclang-rt-14-dev              # libFuzzer + ASan/UBSan runtimes of the fuzz tree (fuzz/, scripts/fuzz.sh)
 )
 
 missing=()

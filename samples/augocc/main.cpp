@@ -18,6 +18,12 @@ int main(int argc, char** argv)
     app.require_subcommand(1);
     Globals g;
     app.add_flag("--quiet,-q", g.quiet, "print nothing but errors");
+    // Runs before the sub-command (CLI11 runs option callbacks while parsing); every stage's
+    // results are the same at any thread count.
+    app.add_option_function<int>(
+           "--threads", [](int n) { cv::setNumThreads(n); },
+           "worker threads (default: all cores); outputs do not depend on it")
+        ->check(CLI::Range(1, 1024));
     // Sub-commands, in pipeline order (one cmd_<name>.cpp each).
     registerSynth(app, g);
     registerTrack(app, g);

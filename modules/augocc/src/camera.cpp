@@ -2,6 +2,7 @@
 // It is subject to the license terms in the LICENSE file found in the top-level directory.
 
 #include "precomp.hpp"
+#include "input_limits.hpp"
 #include "pinhole.hpp"
 
 namespace cv {
@@ -280,6 +281,8 @@ void Camera::validate(const String& what) const
     };
     if (!finite(R.val, 9) || !finite(t.val, 3))
         CV_Error(Error::StsBadArg, where + ": R or t holds a non-finite value");
+    for (int k = 0; k < 3; k++)
+        detail::checkMagnitude(t[k], detail::kMaxSceneCoordinate, where + cv::format(": t[%d]", k));
     const Matx33d RtR = R.t() * R;
     const double orthoErr = cv::norm(RtR - Matx33d::eye(), NORM_INF);
     const double det = cv::determinant(R);
@@ -292,6 +295,9 @@ void Camera::validate(const String& what) const
             CV_Error(Error::StsBadArg, where + cv::format(": scale s = %g must be positive", s));
         if (!std::isfinite(pp.x) || !std::isfinite(pp.y))
             CV_Error(Error::StsBadArg, where + ": principal point is not finite");
+        detail::checkMagnitude(s, detail::kMaxPixelCoordinate, where + ": scale s");
+        detail::checkMagnitude(pp.x, detail::kMaxPixelCoordinate, where + ": principal point x");
+        detail::checkMagnitude(pp.y, detail::kMaxPixelCoordinate, where + ": principal point y");
     }
     else
     {
@@ -302,6 +308,9 @@ void Camera::validate(const String& what) const
                      "be positive", K(0, 0), K(1, 1)));
         if (K(1, 0) != 0 || K(2, 0) != 0 || K(2, 1) != 0 || K(2, 2) != 1)
             CV_Error(Error::StsBadArg, where + ": K must be upper triangular with K(2,2) = 1");
+        for (int k = 0; k < 6; k++)
+            detail::checkMagnitude(K.val[k], detail::kMaxPixelCoordinate,
+                                   where + cv::format(": K(%d, %d)", k / 3, k % 3));
     }
     const size_t n = distortion.size();
     if (n != 0)

@@ -6,6 +6,7 @@
 
 #include "atomic_write.hpp"
 #include "frame_pattern.hpp"
+#include "input_limits.hpp"
 
 #include <atomic>
 #include <cstdio>
@@ -36,20 +37,7 @@ FileNode requireKey(const FileNode& parent, const char* key, const String& where
 
 Mat readMatKey(const FileNode& parent, const char* key, const String& where)
 {
-    FileNode n = requireKey(parent, key, where);
-    if (!n.isMap())
-        CV_Error(Error::StsParseError, where + ": key '" + key + "' is not a matrix");
-    Mat m;
-    try
-    {
-        n >> m;
-    }
-    catch (const cv::Exception& e)
-    {
-        CV_Error(Error::StsParseError, where + ": key '" + key + "' is not a valid matrix (" +
-                 e.err + ")");
-    }
-    return m;
+    return detail::readStorageMat(requireKey(parent, key, where), where, key);
 }
 
 int readIntKey(const FileNode& parent, const char* key, const String& where)
@@ -105,6 +93,7 @@ FileStorage openFileStorageForRead(const String& path, const String& what)
 {
     if (!fs::is_regular_file(path))
         CV_Error(Error::StsObjectNotFound, path + ": " + what + " not found");
+    checkStorageFile(path, what);
     FileStorage storage;
     try
     {
@@ -114,9 +103,20 @@ FileStorage openFileStorageForRead(const String& path, const String& what)
     {
         CV_Error(Error::StsParseError, path + ": cannot parse " + what + ": " + e.err);
     }
+    catch (const std::exception& e)
+    {
+        // OpenCV 4.6's parsers also let std::length_error escape (a string key cut short by a
+        // mutation: found by fuzz_reconstruction).
+        CV_Error(Error::StsParseError, path + ": cannot parse " + what + ": " + e.what());
+    }
     if (!storage.isOpened())
         CV_Error(Error::StsParseError, path + ": cannot open or parse " + what + " as a "
                  "FileStorage file");
+    // Every augocc file is a map of keys: FileNode::operator[] asserts on anything else (found by
+    // fuzz_reconstruction, fuzz_calibration and fuzz_clones).
+    if (!storage.root().isMap())
+        CV_Error(Error::StsParseError, path + ": " + what + ": the top level is not a map of keys");
+    checkDuplicateKeys(storage.root(), path);
     return storage;
 }
 
@@ -373,6 +373,11 @@ void Tracks::validate(const String& what) const
             if (!isFinite2(uv_[i]))
                 CV_Error(Error::StsBadArg, where + cv::format(": observation of track %d in frame "
                          "%d is not finite", p, frame_[i]));
+            if (std::abs(uv_[i].x) > detail::kMaxPixelCoordinate ||
+                std::abs(uv_[i].y) > detail::kMaxPixelCoordinate)
+                CV_Error(Error::StsOutOfRange, where + cv::format(": observation of track %d in "
+                         "frame %d = (%g, %g) px is beyond augocc's limit of %g px", p, frame_[i],
+                         uv_[i].x, uv_[i].y, detail::kMaxPixelCoordinate));
         }
 }
 
@@ -574,6 +579,15 @@ void Reconstruction::validate(const String& what) const
             CV_Error(Error::StsBadSize, where + ": key 'points' must be a P x 3 double matrix, "
                      "got " + cv::format("%dx%d ", points.rows, points.cols) +
                      typeToString(points.type()));
+        // NaN marks a point that is not reconstructed; an infinite or absurd one is an error.
+        for (int i = 0; i < points.rows; i++)
+            for (int k = 0; k < 3; k++)
+            {
+                const double v = points.at<double>(i, k);
+                if (!std::isnan(v))
+                    detail::checkMagnitude(v, detail::kMaxSceneCoordinate,
+                                           where + cv::format(": key 'points' (%d, %d)", i, k));
+            }
     }
 }
 
@@ -791,17 +805,25 @@ ObjectMasks readMasks(const String& dir, Size expectedSize)
         for (const fs::path& f : files)
         {
             const String fname = f.filename().string();
-            if (f.extension() != ".png" || fname[0] == '.')
+            // CONTRACT.md names masks <frame>.png: an upper-case .PNG is an error rather than a
+            // file silently skipped; the stem only decimal digits (" 5", "+5", "5x" are errors,
+            // not frame 5).
+            String ext = f.extension().string();
+            std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+            if (ext != ".png" || fname[0] == '.')
                 continue;
-            int index = -1;
-            char tail = 0;
-            if (std::sscanf(f.stem().string().c_str(), "%d%c", &index, &tail) != 1 || index < 0)
+            if (f.extension() != ".png")
+                CV_Error(Error::StsBadArg, f.string() + ": mask files end in lower-case '.png' "
+                         "(rename it to " + f.stem().string() + ".png)");
+            const String stem = f.stem().string();
+            const bool digits = !stem.empty() && stem.size() <= 9 &&
+                                std::all_of(stem.begin(), stem.end(),
+                                            [](char c) { return c >= '0' && c <= '9'; });
+            if (!digits)
                 CV_Error(Error::StsBadArg, f.string() + ": mask file name must be a frame "
-                         "index such as 0042.png");
-            Mat m = cv::imread(f.string(), IMREAD_GRAYSCALE);
-            if (m.empty())
-                CV_Error(Error::StsParseError, f.string() + ": cannot read image (missing or "
-                         "corrupt)");
+                         "index of 1 to 9 decimal digits such as 0042.png");
+            const int index = std::atoi(stem.c_str());
+            Mat m = detail::readImageChecked(f.string(), IMREAD_GRAYSCALE, true);
             if (!expectedSize.empty() && m.size() != expectedSize)
                 CV_Error(Error::StsBadSize, f.string() + cv::format(": mask is %dx%d but the "
                          "frames are %dx%d", m.cols, m.rows, expectedSize.width,
@@ -857,7 +879,7 @@ public:
     ImageListSource(const String& input, std::vector<String> files)
         : input_(input), files_(std::move(files))
     {
-        Mat first = cv::imread(files_[0], IMREAD_COLOR);
+        Mat first = detail::readImageChecked(files_[0], IMREAD_COLOR);
         if (first.empty())
             CV_Error(Error::StsParseError, files_[0] + ": cannot read image (corrupt or not an "
                      "image)");
@@ -877,9 +899,7 @@ public:
     {
         if (pos_ >= (int)files_.size())
             return false;
-        Mat m = cv::imread(files_[pos_], IMREAD_COLOR);
-        if (m.empty())
-            CV_Error(Error::StsParseError, files_[pos_] + ": cannot read image (corrupt?)");
+        Mat m = detail::readImageChecked(files_[pos_], IMREAD_COLOR);
         if (m.size() != size_)
             CV_Error(Error::StsBadSize, files_[pos_] + cv::format(": image is %dx%d, the first "
                      "frame is %dx%d", m.cols, m.rows, size_.width, size_.height));

@@ -5,6 +5,7 @@
 // transforms applied, and its material (diffuse and ambient colour, diffuse texture).
 
 #include "precomp.hpp"
+#include "input_limits.hpp"
 
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -49,12 +50,26 @@ Mat loadTexture(const aiScene* scene, const aiMaterial* mat, const fs::path& mod
         if (emb->mHeight == 0)
         {
             // Compressed (png, jpg...): mWidth is the byte count.
-            Mat bytes(1, (int)emb->mWidth, CV_8U, (void*)emb->pcData);
-            img = cv::imdecode(bytes, IMREAD_COLOR);
+            const uchar* b = (const uchar*)emb->pcData;
+            try
+            {
+                img = detail::decodeImageChecked(std::vector<uchar>(b, b + emb->mWidth),
+                                                 IMREAD_COLOR, modelPath + ": embedded texture " +
+                                                 String(texPath.C_Str()));
+            }
+            catch (const cv::Exception& e)
+            {
+                CV_LOG_WARNING(NULL, e.err);
+            }
         }
         else
         {
             // Raw aiTexel rows (b, g, r, a), top row first.
+            if ((int64)emb->mWidth > detail::kMaxImageSide || (int64)emb->mHeight >
+                detail::kMaxImageSide)
+                CV_Error(Error::StsOutOfRange, modelPath + cv::format(": embedded texture of %u "
+                         "x %u texels; augocc reads at most %d a side", emb->mWidth,
+                         emb->mHeight, detail::kMaxImageSide));
             Mat bgra((int)emb->mHeight, (int)emb->mWidth, CV_8UC4, (void*)emb->pcData);
             cv::cvtColor(bgra, img, COLOR_BGRA2BGR);
         }
@@ -66,7 +81,16 @@ Mat loadTexture(const aiScene* scene, const aiMaterial* mat, const fs::path& mod
     String rel = texPath.C_Str();
     std::replace(rel.begin(), rel.end(), '\\', '/');
     const fs::path file = fs::path(rel).is_absolute() ? fs::path(rel) : modelDir / rel;
-    Mat img = cv::imread(file.string(), IMREAD_COLOR);
+    Mat img;
+    try
+    {
+        if (fs::is_regular_file(file))
+            img = detail::readImageChecked(file.string(), IMREAD_COLOR);
+    }
+    catch (const cv::Exception& e)
+    {
+        CV_LOG_WARNING(NULL, e.err);
+    }
     if (img.empty())
         CV_LOG_WARNING(NULL, modelPath << ": texture " << file.string()
                        << " cannot be read; using the material colour");
@@ -92,8 +116,12 @@ Material convertMaterial(const aiScene* scene, const aiMaterial* mat, const fs::
 }
 
 void collect(const aiScene* scene, const aiNode* node, const Matx44d& parent,
-             const std::vector<Material>& materials, std::vector<Mesh>& out)
+             const std::vector<Material>& materials, std::vector<Mesh>& out, const String& path,
+             int depth = 0)
 {
+    if (depth > detail::kMaxStorageDepth)
+        CV_Error(Error::StsOutOfRange, path + cv::format(": mesh file's node tree nests deeper "
+                 "than augocc's limit of %d levels", detail::kMaxStorageDepth));
     const Matx44d M = parent * toMatx(node->mTransformation);
     const Matx33d L(M(0, 0), M(0, 1), M(0, 2), M(1, 0), M(1, 1), M(1, 2), M(2, 0), M(2, 1),
                     M(2, 2));
@@ -112,6 +140,11 @@ void collect(const aiScene* scene, const aiNode* node, const Matx44d& parent,
             const aiVector3D& p = am->mVertices[v];
             const Vec4d q = M * Vec4d(p.x, p.y, p.z, 1.0);
             const double w = std::abs(q[3]) > 0 ? q[3] : 1.0;
+            for (int k = 0; k < 3; k++)
+                if (!(std::abs(q[k] / w) <= detail::kMaxSceneCoordinate))
+                    CV_Error(Error::StsOutOfRange, path + cv::format(": vertex %u of mesh %u has "
+                             "coordinate %g: not finite or beyond augocc's limit of %g", v,
+                             node->mMeshes[i], q[k] / w, detail::kMaxSceneCoordinate));
             m.vertices[v] = Vec3f((float)(q[0] / w), (float)(q[1] / w), (float)(q[2] / w));
         }
         if (am->HasNormals())
@@ -161,7 +194,7 @@ void collect(const aiScene* scene, const aiNode* node, const Matx44d& parent,
         out.push_back(std::move(m));
     }
     for (unsigned int c = 0; c < node->mNumChildren; c++)
-        collect(scene, node->mChildren[c], M, materials, out);
+        collect(scene, node->mChildren[c], M, materials, out, path, depth + 1);
 }
 
 } // namespace
@@ -170,6 +203,7 @@ std::vector<Mesh> loadMeshes(const String& path)
 {
     if (!fs::is_regular_file(path))
         CV_Error(Error::StsObjectNotFound, path + ": mesh file not found");
+    detail::checkMeshFile(path);
     Assimp::Importer importer;
     // Points and lines are dropped (SortByPType + the flag below); normals are generated where the
     // file has none; node transforms are applied here rather than by PreTransformVertices so that
@@ -187,7 +221,7 @@ std::vector<Mesh> loadMeshes(const String& path)
     for (unsigned int i = 0; i < scene->mNumMaterials; i++)
         materials.push_back(convertMaterial(scene, scene->mMaterials[i], dir, path));
     std::vector<Mesh> meshes;
-    collect(scene, scene->mRootNode, Matx44d::eye(), materials, meshes);
+    collect(scene, scene->mRootNode, Matx44d::eye(), materials, meshes, path);
     if (meshes.empty())
         CV_Error(Error::StsParseError, path + ": mesh file holds no triangle");
     return meshes;

@@ -6,6 +6,7 @@
 
 #include "precomp.hpp"
 #include "ground_plane.hpp"
+#include "input_limits.hpp"
 #include "io_internal.hpp"
 
 #include "atomic_write.hpp"
@@ -43,6 +44,9 @@ double readNumber(const FileNode& n, const String& file, const String& where)
     const double v = (double)n;
     if (!std::isfinite(v))
         sceneError(file, where, "value is not finite");
+    if (std::abs(v) > detail::kMaxSceneCoordinate)
+        sceneError(file, where, cv::format("%g is beyond augocc's limit of %g", v,
+                                           detail::kMaxSceneCoordinate));
     return v;
 }
 
@@ -258,9 +262,17 @@ VirtualScene readScene(const String& path)
                 {
                     const String rel = readString(m["texture"], path, where + ".material.texture");
                     const String file = fs::path(rel).is_absolute() ? rel : (dir / rel).string();
-                    Mat tex = cv::imread(file, IMREAD_COLOR);
-                    if (tex.empty())
+                    if (!fs::is_regular_file(file))
                         sceneError(path, where + ".material.texture", file + ": cannot read image");
+                    Mat tex;
+                    try
+                    {
+                        tex = detail::readImageChecked(file, IMREAD_COLOR);
+                    }
+                    catch (const cv::Exception& e)
+                    {
+                        sceneError(path, where + ".material.texture", e.err);
+                    }
                     mesh.material.texture = tex;
                 }
             }

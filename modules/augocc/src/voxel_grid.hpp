@@ -105,6 +105,10 @@ struct VoxelProjector
             rv = 0.5 * iw * (std::abs(M(1, 0) - v * M(2, 0)) + std::abs(M(1, 1) - v * M(2, 1)) +
                              std::abs(M(1, 2) - v * M(2, 2)));
         }
+        // Beyond 2^30 px the pixel arithmetic below would overflow int (readers reject such
+        // cameras; this keeps any other caller defined): the voxel is off every image.
+        if (!(std::abs(u) + ru < 1073741824.0 && std::abs(v) + rv < 1073741824.0))
+            return false;
         const int pu = cvRound(u), pv = cvRound(v);
         x0 = std::min(cvCeil(u - ru), pu);
         x1 = std::max(cvFloor(u + ru), pu);

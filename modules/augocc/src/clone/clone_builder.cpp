@@ -210,6 +210,12 @@ void CloneBuilderImpl::addKeyFrame(CloneSet& clones, const Reconstruction& rec,
     ObjectClone& obj = set.get(object);
     Mat m = mask.getMat();
     checkMask(m, rec, object, frame);
+    for (const auto& km : obj.masks)
+        if (km.second.size() != rec.imageSize)
+            CV_Error(Error::StsBadSize, cv::format("CloneBuilder::addKeyFrame: object '%s': key "
+                     "frame %d's silhouette is %dx%d, the reconstruction's image size %dx%d",
+                     object.c_str(), km.first, km.second.cols, km.second.rows,
+                     rec.imageSize.width, rec.imageSize.height));
     obj.masks[frame] = m > 127;
     const IdealSpace space = makeIdealSpace(rec, "CloneBuilder::addKeyFrame");
     const IdealMasks idealMasks(set, space);

@@ -84,10 +84,26 @@ std::vector<uchar> readBlob(const FileNode& node, const String& what)
 {
     if (node.empty() || !node.isMap())
         CV_Error(Error::StsParseError, what + ": missing");
+    if (!node["bytes"].isInt() && !node["bytes"].isReal())
+        CV_Error(Error::StsParseError, what + ": key 'bytes' must be a number");
     const double expected = (double)node["bytes"];
-    std::vector<uchar> out;
-    out.reserve((size_t)std::max(0.0, expected));
     FileNode seq = node["b64"];
+    if (!seq.isSeq())
+        CV_Error(Error::StsParseError, what + ": key 'b64' must be a sequence of strings");
+    // The declared size is bounded by what the base64 text can hold (3 bytes per 4 characters)
+    // before anything is reserved.
+    double capacity = 0;
+    for (FileNodeIterator it = seq.begin(); it != seq.end(); ++it)
+    {
+        if (!(*it).isString())
+            CV_Error(Error::StsParseError, what + ": key 'b64' must be a sequence of strings");
+        capacity += (double)((std::string)*it).size() * 3 / 4;
+    }
+    if (!(expected >= 0 && expected <= capacity && expected == std::floor(expected)))
+        CV_Error(Error::StsParseError, what + cv::format(": key 'bytes' = %g but the data holds "
+                 "at most %.0f bytes", expected, capacity));
+    std::vector<uchar> out;
+    out.reserve((size_t)expected);
     for (FileNodeIterator it = seq.begin(); it != seq.end(); ++it)
     {
         const std::string s = (std::string)*it;
@@ -151,6 +167,11 @@ std::vector<uchar> encodeGrid(const std::vector<uchar>& data, int nx, int rows)
 void decodeGrid(const std::vector<uchar>& bytes, int nx, int rows, std::vector<uchar>& data,
                 const String& what)
 {
+    // Every row takes at least one byte (its run count): a grid the data cannot fill is corrupt,
+    // found before the allocation.
+    if (bytes.size() < (size_t)rows)
+        CV_Error(Error::StsParseError, what + cv::format(": corrupt voxel data (%zu bytes for "
+                 "%d rows)", bytes.size(), rows));
     data.assign((size_t)nx * rows, 0);
     std::vector<int> prev, cur;
     size_t pos = 0;

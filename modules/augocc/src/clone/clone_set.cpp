@@ -7,6 +7,7 @@
 #include "atomic_write.hpp"
 #include "clone/clone_set.hpp"
 #include "clone/clone_codec.hpp"
+#include "input_limits.hpp"
 #include "io_internal.hpp"
 
 #include <filesystem>
@@ -247,39 +248,68 @@ Ptr<CloneSet> CloneSet::load(const String& path)
 {
     using namespace detail;
     FileStorage fs = openFileStorageForRead(path, "clones file");
-    if ((String)fs["format"] != "augocc_clones")
+    if (!fs["format"].isString() || (String)fs["format"] != "augocc_clones")
         CV_Error(Error::StsParseError, path + ": key 'format' is not 'augocc_clones'");
+    if (!fs["version"].isInt() || (int)fs["version"] != 1)
+        CV_Error(Error::StsParseError, path + ": key 'version' must be 1 (this augocc reads "
+                 "version 1 clones files)");
     Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
-    const String rule = (String)fs["patch_rule"];
+    const String rule = fs["patch_rule"].isString() ? (String)fs["patch_rule"] : String();
+    if (rule != "bracketing" && rule != "nearest")
+        CV_Error(Error::StsParseError, path + ": key 'patch_rule' must be 'bracketing' or "
+                 "'nearest'");
     set->patchRule = rule == "bracketing" ? CloneBuilder::PATCH_BRACKETING
                                           : CloneBuilder::PATCH_NEAREST;
     FileNode objs = fs["objects"];
     if (!objs.isSeq())
         CV_Error(Error::StsParseError, path + ": key 'objects' must be a sequence");
+    Size maskSize;
     for (FileNodeIterator it = objs.begin(); it != objs.end(); ++it)
     {
         FileNode n = *it;
+        if (!n.isMap())
+            CV_Error(Error::StsParseError, path + ": an element of 'objects' is not a map");
         ObjectClone o;
+        if (!n["name"].isString())
+            CV_Error(Error::StsParseError, path + ": an object has no 'name'");
         n["name"] >> o.name;
         const String where = path + ": object '" + o.name + "'";
         if (o.name.empty())
             CV_Error(Error::StsParseError, path + ": an object has no 'name'");
-        Mat dims, R, origin, centre;
-        n["dims"] >> dims;
-        n["R_box"] >> R;
-        n["origin"] >> origin;
-        n["centre"] >> centre;
-        double h = 0;
-        n["voxel_size"] >> h;
-        if (dims.total() != 3 || R.rows != 3 || R.cols != 3 || origin.total() != 3 ||
-            centre.total() != 3 || !(h > 0))
+        if (set->objects().count(o.name))
+            CV_Error(Error::StsParseError, where + ": a second object of that name");
+        const Mat dims = readStorageMat(n["dims"], where, "dims");
+        Mat R = readStorageMat(n["R_box"], where, "R_box");
+        Mat origin = readStorageMat(n["origin"], where, "origin");
+        Mat centre = readStorageMat(n["centre"], where, "centre");
+        if (!n["voxel_size"].isReal() && !n["voxel_size"].isInt())
+            CV_Error(Error::StsParseError, where + ": key 'voxel_size' must be a number");
+        const double h = (double)n["voxel_size"];
+        if (dims.total() != 3 || dims.channels() != 1 || R.rows != 3 || R.cols != 3 ||
+            R.channels() != 1 || origin.total() != 3 || origin.channels() != 1 ||
+            centre.total() != 3 || centre.channels() != 1 || !(h > 0) ||
+            !(h <= kMaxSceneCoordinate))
             CV_Error(Error::StsParseError, where + ": missing or malformed dims, R_box, origin, "
                      "centre or voxel_size");
-        dims.convertTo(dims, CV_32S);
+        Mat dimsD;
+        dims.convertTo(dimsD, CV_64F);
+        for (int k = 0; k < 3; k++)
+            if (!(dimsD.ptr<double>()[k] >= 1 && dimsD.ptr<double>()[k] <= kMaxGridDim))
+                CV_Error(Error::StsParseError, where + ": bad grid dims");
+        Mat dimsI;
+        dimsD.convertTo(dimsI, CV_32S);
         R.convertTo(R, CV_64F);
         origin.convertTo(origin, CV_64F);
         centre.convertTo(centre, CV_64F);
-        const Vec3i d(dims.ptr<int>()[0], dims.ptr<int>()[1], dims.ptr<int>()[2]);
+        for (int k = 0; k < 9; k++)
+            checkMagnitude(R.ptr<double>()[k], 1.0 + 1e-6, where + ": R_box");
+        for (int k = 0; k < 3; k++)
+        {
+            checkMagnitude(origin.ptr<double>()[k], kMaxSceneCoordinate, where + ": origin");
+            checkMagnitude(centre.ptr<double>()[k], kMaxSceneCoordinate, where + ": centre");
+        }
+        const Mat& dims_ = dimsI;
+        const Vec3i d(dims_.ptr<int>()[0], dims_.ptr<int>()[1], dims_.ptr<int>()[2]);
         if (d[0] <= 0 || d[1] <= 0 || d[2] <= 0 || std::max(d[0], std::max(d[1], d[2])) > kMaxGridDim)
             CV_Error(Error::StsParseError, where + ": bad grid dims");
         o.grid.dims = d;
@@ -293,12 +323,25 @@ Ptr<CloneSet> CloneSet::load(const String& path)
         for (FileNodeIterator k = kfs.begin(); k != kfs.end(); ++k)
         {
             int frame = -1;
-            (*k)["frame"] >> frame;
+            if ((*k).isMap() && (*k)["frame"].isInt())
+                (*k)["frame"] >> frame;
             const String kw = where + cv::format(" key frame %d", frame);
+            if (frame < 0)
+                CV_Error(Error::StsParseError, kw + ": no frame index");
+            if (o.masks.count(frame))
+                CV_Error(Error::StsParseError, kw + ": a second key frame of that index");
             const std::vector<uchar> png = readBlob((*k)["mask_png"], kw + " mask_png");
-            Mat mask = png.empty() ? Mat() : cv::imdecode(png, IMREAD_GRAYSCALE);
-            if (frame < 0 || mask.empty())
-                CV_Error(Error::StsParseError, kw + ": no frame index or no readable mask");
+            Mat mask = decodeImageChecked(png, IMREAD_GRAYSCALE, kw + " mask_png");
+            if (mask.empty())
+                CV_Error(Error::StsParseError, kw + ": no readable mask");
+            // Every key-frame mask is the frames' size (the reader of the reconstruction checks
+            // it against its image_size: CloneSet::checkAgainst).
+            if (maskSize.empty())
+                maskSize = mask.size();
+            else if (mask.size() != maskSize)
+                CV_Error(Error::StsBadSize, kw + cv::format(": mask is %dx%d but the file's first "
+                         "key-frame mask is %dx%d", mask.cols, mask.rows, maskSize.width,
+                         maskSize.height));
             o.masks[frame] = mask > 127;
             const std::vector<uchar> pv = readBlob((*k)["patches"], kw + " patches");
             size_t pos = 0;
@@ -331,6 +374,16 @@ void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks
     const int nc = (int)rec.cameras.size();
     if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
         CV_Error(Error::StsBadSize, "renderMattes: reconstruction has no image size");
+    // A clones file built for other frames: its key-frame silhouettes have another size.
+    if (const detail::CloneSetImpl* impl = dynamic_cast<const detail::CloneSetImpl*>(&clones))
+        for (const auto& o : impl->objects())
+            for (const auto& km : o.second.masks)
+                if (km.second.size() != rec.imageSize)
+                    CV_Error(Error::StsBadSize, cv::format("clones: object '%s': key frame %d's "
+                             "silhouette is %dx%d but the reconstruction's frames are %dx%d (a "
+                             "clones file of another video?)", o.first.c_str(), km.first,
+                             km.second.cols, km.second.rows, rec.imageSize.width,
+                             rec.imageSize.height));
     std::vector<std::vector<Mat> > m(names.size(), std::vector<Mat>(nc)), d = m;
     // Batches of frames, each in parallel, progress reported between them (from this thread).
     // Each matte depends on its frame alone: the batching does not change them.

@@ -1,0 +1,15 @@
+// This file is part of augocc. License: Apache-2.0.
+// It is subject to the license terms in the LICENSE file found in the top-level directory.
+
+// libFuzzer harness: the tracks file (augocc track's output).
+
+#include "fuzz_common.hpp"
+
+#include <opencv2/augocc.hpp>
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
+{
+    const std::string path = augocc_fuzz::writeInput(data, size, "tracks.yml");
+    augocc_fuzz::readSafely([&] { cv::augocc::readTracks(path); });
+    return 0;
+}
