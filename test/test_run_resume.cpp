@@ -329,10 +329,16 @@ TEST(Augocc_RunDriver, results_do_not_depend_on_progress)
     const Reconstruction a = recoverCameras(scene.tracks, plain);
     const Reconstruction b = recoverCameras(scene.tracks, reported);
     ASSERT_EQ(a.cameras.size(), b.cameras.size());
+    // Not bit for bit: two calls of recoverCameras on the same tracks, with the same options,
+    // already differ by up to ~1e-15 here (and ~1e-6 with the perspective model), one thread
+    // or two (measured 2026-12-02; the cause is open: issue 17, determinism). 1e-9 is a
+    // million times that noise; the clones and mattes below, built from one reconstruction,
+    // are compared exactly.
+    const double kCallNoise = 1e-9;
     for (size_t i = 0; i < a.cameras.size(); i++)
     {
-        EXPECT_EQ(0, cv::norm(Mat(a.cameras[i].R), Mat(b.cameras[i].R), NORM_INF)) << i;
-        EXPECT_EQ(0, cv::norm(Mat(a.cameras[i].t), Mat(b.cameras[i].t), NORM_INF)) << i;
+        EXPECT_LE(cv::norm(Mat(a.cameras[i].R), Mat(b.cameras[i].R), NORM_INF), kCallNoise) << i;
+        EXPECT_LE(cv::norm(Mat(a.cameras[i].t), Mat(b.cameras[i].t), NORM_INF), kCallNoise) << i;
     }
     CloneBuilder::Params cp;
     const Ptr<CloneSet> ca = CloneBuilder::create(cp)->build(a, scene.keyFrameMasks,

@@ -711,10 +711,10 @@ double sumSquaredResiduals(const Tracks& tracks, const Reconstruction& rec,
     for (const Camera& cam : rec.cameras)
     {
         const Range obs = tracks.frame(cam.frame);
-        for (int k = obs.start; k < obs.end; k++)
+        for (int j = obs.start; j < obs.end; j++)
         {
-            const int p = tracks.pointOf(tracks.byFrame(k));
-            const Point2f o = tracks.uv(tracks.byFrame(k));
+            const int p = tracks.pointOf(tracks.byFrame(j));
+            const Point2f o = tracks.uv(tracks.byFrame(j));
             if (!rec.hasPoint(p))
                 continue;
             const Point2d e = cam.project(rec.point(p)) - Point2d(o.x, o.y);

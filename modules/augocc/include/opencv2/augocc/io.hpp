@@ -45,8 +45,9 @@ struct CV_EXPORTS Tracks
     StsUnsupportedFormat for another type. */
     static Tracks fromDense(Size imageSize, const Mat& dense, const String& what = "tracks");
     /** @brief Tracks of F frames and P points from N observations in any order.
+    @param imageSize size of the frames. @param frames F. @param points P.
     @param index N x 2 CV_32S (frame, point), or empty. @param uv N x 2 CV_32F (u, v) (CV_64F is
-    converted), or empty. Throws cv::Exception naming `what` on a bad shape or type, a frame or
+    converted), or empty. @param what names the source in error messages. Throws cv::Exception naming `what` on a bad shape or type, a frame or
     point out of range, a repeated (frame, point) or a non-finite position. */
     static Tracks fromObservations(Size imageSize, int frames, int points, const Mat& index,
                                    const Mat& uv, const String& what = "tracks");
@@ -97,6 +98,7 @@ struct CV_EXPORTS Tracks
     class CV_EXPORTS Builder
     {
     public:
+        //! An empty set of tracks over `frames` frames of `imageSize`.
         Builder(Size imageSize, int frames);
         //! Starts a new track; returns its number p.
         int addTrack();
