@@ -211,6 +211,24 @@ TEST(Augocc_CliRuns, kill9_then_rerun_leaves_complete_outputs)
         ASSERT_TRUE(got.count("clones.yml.gz")) << "killed at " << at << " s";
         EXPECT_NO_THROW(CloneSet::load(dir + "/clones.yml.gz"));
         got["clones.yml.gz"] = want["clones.yml.gz"];
+        // The reconstruction likewise: recoverCameras is not bit-reproducible from run to run
+        // (two calls on the same tracks differ by up to ~1e-6 in the perspective cameras,
+        // measured 2026-12-02; issue 17, determinism, open). It must read back whole and
+        // agree with the uninterrupted run's within 1e-4 (100x that spread).
+        {
+            const Reconstruction a = readReconstruction(ref + "/reconstruction.yml");
+            const Reconstruction b = readReconstruction(dir + "/reconstruction.yml");
+            ASSERT_EQ(a.cameras.size(), b.cameras.size()) << "killed at " << at << " s";
+            const double kRunSpread = 1e-4;
+            for (size_t i = 0; i < a.cameras.size(); i++)
+            {
+                EXPECT_LE(cv::norm(Mat(a.cameras[i].R), Mat(b.cameras[i].R), NORM_INF),
+                          kRunSpread) << i;
+                EXPECT_LE(cv::norm(Mat(a.cameras[i].t), Mat(b.cameras[i].t), NORM_INF),
+                          kRunSpread * (1 + cv::norm(a.cameras[i].t))) << i;
+            }
+            got["reconstruction.yml"] = want["reconstruction.yml"];
+        }
         // The run's manifests (resume: src/run_manifest.hpp) record the modification times of
         // the files they sign, which differ from run to run: each must be there, its bytes are
         // not compared.

@@ -88,19 +88,6 @@ Plan planShot(const Shot& s, const Options& w)
     return p;
 }
 
-void writeText(const std::string& path, const std::string& text, bool executable)
-{
-    cv::augocc::writeAtomically(path, [&](const cv::String& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.close();
-        if (!out)
-            CV_Error(cv::Error::StsError, path + ": cannot be written");
-        if (executable && chmod(tmp.c_str(), 0755) != 0)
-            CV_Error(cv::Error::StsError, path + ": cannot be made executable");
-    });
-}
-
 // argv run without a shell; its standard output, or UsageError with its exit status.
 std::string runCapture(const std::vector<std::string>& argv)
 {
@@ -223,7 +210,7 @@ void runFarm(const Globals& g, const FarmCliOptions& o)
         for (const Script& s : makeScripts(p, w))
         {
             const std::string path = (farmDir / s.file).string();
-            writeText(path, s.text, true);
+            farm::writeTextFile(path, s.text, true);
             if (o.dryRun)
                 std::cout << "# ==> " << path << " <==\n" << s.text << "\n";
         }

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <sys/stat.h>
 #include <opencv2/augocc.hpp>
 
 namespace fs = std::filesystem;
@@ -366,13 +367,19 @@ void writePlan(const Plan& plan, const Options& o)
     for (const std::string& l : o.setup)
         fsw << l;
     fsw << "]";
-    const std::string text = fsw.releaseAndGetString();
+    writeTextFile(path, fsw.releaseAndGetString());
+}
+
+void writeTextFile(const std::string& path, const std::string& text, bool executable)
+{
     cv::augocc::writeAtomically(path, [&](const cv::String& tmp) {
         std::ofstream out(tmp, std::ios::binary);
         out << text;
         out.close();
         if (!out)
             CV_Error(cv::Error::StsError, path + ": cannot be written");
+        if (executable && chmod(tmp.c_str(), 0755) != 0)
+            CV_Error(cv::Error::StsError, path + ": cannot be made executable");
     });
 }
 

@@ -111,6 +111,10 @@ std::vector<std::string> sbatchArgs(const Submission& s, const std::string& depe
 std::string arraySpec(const std::vector<int>& tasks);
 
 //! Writes / reads outDir/farm/plan.yml (what resume needs; cv::FileStorage YAML).
+/** Writes `text` to `path` all or nothing (writeAtomically), mode 0755 when `executable`;
+cv::Exception naming the path when it cannot. */
+void writeTextFile(const std::string& path, const std::string& text, bool executable = false);
+
 void writePlan(const Plan& plan, const Options& options);
 void readPlan(const std::string& outDir, Plan& plan, Options& options);
 

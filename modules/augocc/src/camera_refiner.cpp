@@ -754,12 +754,18 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     for (size_t k = 0; k < std::min<size_t>(12, c0.distortion.size()); k++)
         dist[k] = c0.distortion[k];
     const Matx33d tilt = tiltHomography(c0.distortion);
-    std::vector<Eigen::Quaterniond> q(n);
-    std::vector<Vec3d> t(n);
+    // Every pose in one buffer, camera after camera (quaternion x, y, z, w, then t): Ceres
+    // orders the blocks of an elimination group by their addresses, and poses in separate heap
+    // buffers (one for the rotations, one for the translations) came in an order that changed
+    // from run to run with the allocator's state, and with it the last digits of the solution.
+    std::vector<double> poses(7 * (size_t)n);
+    auto qd = [&](int i) { return &poses[7 * (size_t)i]; };
+    auto td = [&](int i) { return &poses[7 * (size_t)i + 4]; };
     for (int i = 0; i < n; i++)
     {
-        q[i] = detail::toQuaternion(rec.cameras[i].R);
-        t[i] = rec.cameras[i].t;
+        const Eigen::Quaterniond qi = detail::toQuaternion(rec.cameras[i].R);
+        std::copy(qi.coeffs().data(), qi.coeffs().data() + 4, qd(i));
+        std::copy(rec.cameras[i].t.val, rec.cameras[i].t.val + 3, td(i));
     }
     Mat X = rec.points.clone();
     ceres::Problem::Options po;
@@ -777,7 +783,7 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     forEachObservationPointMajor(tracks, rec, used,
                                  [&](int i, int p, const Point2f& o, const Point2d&) {
         problem.AddResidualBlock(detail::LensReprojectionError::Create(o.x, o.y, aspect, skew,
-                                 tilt), loss.get(), q[i].coeffs().data(), t[i].val,
+                                 tilt), loss.get(), qd(i), td(i),
                                  X.ptr<double>(p), intr, dist);
     });
     if (problem.NumResidualBlocks() == 0)
@@ -787,11 +793,11 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     const Vec3d center0 = c0.center();
     for (int i = 0; i < n; i++)
     {
-        if (!problem.HasParameterBlock(q[i].coeffs().data()))
+        if (!problem.HasParameterBlock(qd(i)))
             continue;
-        problem.SetManifold(q[i].coeffs().data(), &quatManifold);
-        ordering->AddElementToGroup(q[i].coeffs().data(), 1);
-        ordering->AddElementToGroup(t[i].val, 1);
+        problem.SetManifold(qd(i), &quatManifold);
+        ordering->AddElementToGroup(qd(i), 1);
+        ordering->AddElementToGroup(td(i), 1);
         const double d = cv::norm(rec.cameras[i].center() - center0);
         if (i > 0 && d > best)
         {
@@ -807,8 +813,8 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     // Gauge: the first camera's pose; the scale by the coordinate of the farthest camera's
     // translation that a scaling about the first camera's centre changes most,
     // d t_k / d lambda = -R_k (c_k - c_0). Without camera motion, no scale to fix.
-    problem.SetParameterBlockConstant(q[0].coeffs().data());
-    problem.SetParameterBlockConstant(t[0].val);
+    problem.SetParameterBlockConstant(qd(0));
+    problem.SetParameterBlockConstant(td(0));
     std::unique_ptr<ceres::SubsetManifold> scaleGauge, intrManifold, distManifold;
     if (farthest > 0)
     {
@@ -819,7 +825,7 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
             if (std::abs(g[k]) > std::abs(g[j]))
                 j = k;
         scaleGauge.reset(new ceres::SubsetManifold(3, {j}));
-        problem.SetManifold(t[farthest].val, scaleGauge.get());
+        problem.SetManifold(td(farthest), scaleGauge.get());
     }
     if (freedom.focal)
     {
@@ -896,7 +902,7 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     for (int i = 0; i < n; i++)
     {
         Camera& cam = rec.cameras[i];
-        cam = Camera::perspective(detail::fromQuaternion(q[i].coeffs().data()), t[i], K,
+        cam = Camera::perspective(detail::fromQuaternion(qd(i)), Vec3d(td(i)), K,
                                   cam.frame, d);
     }
     for (int p = 0; p < P; p++)
