@@ -203,18 +203,17 @@ TEST(Augocc_CliRuns, kill9_then_rerun_leaves_complete_outputs)
         landed += killAfter(runArgs(d, dir, 2), std::chrono::milliseconds((int)(at * 1000))) ? 1
                                                                                               : 0;
         ASSERT_EQ(0, runCommand(joinArgs(runArgs(d, dir, 2)), &out)) << "re-run " << k << out;
-        // The same names (nothing partial left under any other), the same bytes; the clones
-        // file only where run is itself reproducible (see the disabled test above): there it
-        // must read back whole.
+        // Crash safety: exactly the uninterrupted run's names (nothing partial left under any
+        // other), each output complete. Bytes are compared where `run` is reproducible from run
+        // to run (the tracks); the outputs downstream of the cameras are not: recoverCameras
+        // differs from call to call by up to ~1e-6 in perspective cameras, and the clones
+        // file's R_box at 2 threads (issue 17, determinism, open; see the disabled test above).
+        // Those must read back whole: the reconstruction within 1e-4 (100x that spread) of the
+        // uninterrupted run's, the clones file loading, every matte decoding, the composite
+        // with as many frames. The manifests (src/run_manifest.hpp) record modification times:
+        // present, bytes not compared.
         auto got = snapshot(dir);
         auto want = expected;
-        ASSERT_TRUE(got.count("clones.yml.gz")) << "killed at " << at << " s";
-        EXPECT_NO_THROW(CloneSet::load(dir + "/clones.yml.gz"));
-        got["clones.yml.gz"] = want["clones.yml.gz"];
-        // The reconstruction likewise: recoverCameras is not bit-reproducible from run to run
-        // (two calls on the same tracks differ by up to ~1e-6 in the perspective cameras,
-        // measured 2026-12-02; issue 17, determinism, open). It must read back whole and
-        // agree with the uninterrupted run's within 1e-4 (100x that spread).
         {
             const Reconstruction a = readReconstruction(ref + "/reconstruction.yml");
             const Reconstruction b = readReconstruction(dir + "/reconstruction.yml");
@@ -227,19 +226,25 @@ TEST(Augocc_CliRuns, kill9_then_rerun_leaves_complete_outputs)
                 EXPECT_LE(cv::norm(Mat(a.cameras[i].t), Mat(b.cameras[i].t), NORM_INF),
                           kRunSpread * (1 + cv::norm(a.cameras[i].t))) << i;
             }
-            got["reconstruction.yml"] = want["reconstruction.yml"];
         }
-        // The run's manifests (resume: src/run_manifest.hpp) record the modification times of
-        // the files they sign, which differ from run to run: each must be there, its bytes are
-        // not compared.
-        const std::string manifest = ".manifest.yml";
-        for (const auto& w : want)
-            if (w.first.size() > manifest.size() &&
-                w.first.compare(w.first.size() - manifest.size(), manifest.size(), manifest) == 0)
+        EXPECT_NO_THROW(CloneSet::load(dir + "/clones.yml.gz")) << "killed at " << at << " s";
+        for (auto& w : want)
+        {
+            auto g = got.find(w.first);
+            ASSERT_TRUE(g != got.end()) << w.first << " missing, killed at " << at << " s";
+            const fs::path rel(w.first);
+            const bool bytesCompared = w.first == "tracks.yml";
+            if (rel.extension() == ".png")
             {
-                ASSERT_TRUE(got.count(w.first)) << w.first << ", killed at " << at << " s";
-                got[w.first] = w.second;
+                EXPECT_FALSE(imread(dir + "/" + w.first, IMREAD_UNCHANGED).empty()) << w.first;
             }
+            if (w.first.find("(decoded frames)") != std::string::npos)
+            {
+                EXPECT_EQ(w.second.size(), g->second.size()) << w.first;  // as many frames
+            }
+            if (!bytesCompared)
+                g->second = w.second;
+        }
         EXPECT_TRUE(sameFiles(want, got)) << "killed at " << at << " s of " << full;
         fs::remove_all(dir);
     }
