@@ -258,6 +258,16 @@ TEST(Augocc_InputLimits, regression_mesh_cut_in_header_and_body)
     // Found by fuzz_mesh: a header with no vertex element made Assimp loop for ever.
     EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_no_vertex.ply")); },
                            {"fuzz_mesh_no_vertex.ply", "no 'element vertex'"}));
+    // Found by fuzz_mesh (2026-12-02): misspelt header keywords that the pre-check skipped and
+    // Assimp read otherwise: a vertex without y crashed its post-processing (SIGSEGV), a garbled
+    // "property" leaked.
+    EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_misspelt_property.ply")); },
+                           {"fuzz_mesh_misspelt_property.ply", "bad line 'format ascii 1.`0'"}));
+    EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_garbled_keyword.ply")); },
+                           {"fuzz_mesh_garbled_keyword.ply", "unknown line"}));
+    // A binary face of no corner: SIGSEGV in Assimp's post-processing.
+    EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_face_without_corners.ply")); },
+                           {"fuzz_mesh_face_without_corners.ply", "face 0 has 0 corners"}));
     // The whole file still loads.
     EXPECT_NO_THROW(loadMeshes(dataFile("tetra.ply")));
 }

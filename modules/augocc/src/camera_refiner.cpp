@@ -274,16 +274,15 @@ ceres::Problem::Options bundleProblemOptions()
 bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction& rec) const
 {
     const int n = (int)rec.cameras.size(), P = tracks.points();
-    std::vector<Eigen::Quaterniond> q(n);
-    std::vector<Vec2d> t(n);
-    std::vector<double> s(n);
+    detail::CameraBlocks cams(n, 2, 1);  // q, (tx, ty), s
     double sGlobal = 0;
     for (int i = 0; i < n; i++)
     {
-        q[i] = detail::toQuaternion(rec.cameras[i].R);
-        t[i] = Vec2d(rec.cameras[i].t[0], rec.cameras[i].t[1]);
-        s[i] = rec.cameras[i].s;
-        sGlobal += s[i] / n;
+        cams.setRotation(i, rec.cameras[i].R);
+        cams.t(i)[0] = rec.cameras[i].t[0];
+        cams.t(i)[1] = rec.cameras[i].t[1];
+        *cams.extra(i) = rec.cameras[i].s;
+        sGlobal += rec.cameras[i].s / n;
     }
     Mat X = rec.points.clone();
     std::deque<detail::OrthoReprojectionCost> costs;  // declared before the problem: outlives it
@@ -295,26 +294,27 @@ bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction&
     forEachObservationPointMajor(tracks, rec, used,
                                  [&](int i, int p, const Point2f& o, const Point2d& pp) {
         costs.emplace_back(o.x, o.y, pp.x, pp.y);
-        problem.AddResidualBlock(&costs.back(), loss.get(), q[i].coeffs().data(), t[i].val,
-                                 params_.perFrameScale ? &s[i] : &sGlobal, X.ptr<double>(p));
+        problem.AddResidualBlock(&costs.back(), loss.get(), cams.q(i), cams.t(i),
+                                 params_.perFrameScale ? cams.extra(i) : &sGlobal,
+                                 X.ptr<double>(p));
     });
     for (int i = 0; i < n; i++)
     {
-        if (problem.HasParameterBlock(q[i].coeffs().data()))
+        if (problem.HasParameterBlock(cams.q(i)))
         {
-            problem.SetManifold(q[i].coeffs().data(), &quatManifold);
-            ordering->AddElementToGroup(q[i].coeffs().data(), 1);
-            ordering->AddElementToGroup(t[i].val, 1);
+            problem.SetManifold(cams.q(i), &quatManifold);
+            ordering->AddElementToGroup(cams.q(i), 1);
+            ordering->AddElementToGroup(cams.t(i), 1);
             if (params_.perFrameScale)
-                ordering->AddElementToGroup(&s[i], 1);
+                ordering->AddElementToGroup(cams.extra(i), 1);
         }
     }
     if (problem.NumResidualBlocks() == 0)
         CV_Error(Error::StsBadArg, "reconstruction: no observation of a reconstructed point");
     // Gauge: the first camera's rotation and the zoom (global, or the first camera's).
-    problem.SetParameterBlockConstant(q[0].coeffs().data());
+    problem.SetParameterBlockConstant(cams.q(0));
     if (params_.perFrameScale)
-        problem.SetParameterBlockConstant(&s[0]);
+        problem.SetParameterBlockConstant(cams.extra(0));
     else
     {
         ordering->AddElementToGroup(&sGlobal, 1);
@@ -344,10 +344,10 @@ bool OrthoCameraRefinerImpl::refineOrthoBA(const Tracks& tracks, Reconstruction&
     for (int i = 0; i < n; i++)
     {
         Camera& cam = rec.cameras[i];
-        cam.R = detail::fromQuaternion(q[i].coeffs().data());
+        cam.R = cams.rotation(i);
         const Vec3d Rc = cam.R * c;
-        cam.t = Vec3d(t[i][0] + Rc[0], t[i][1] + Rc[1], cam.t[2]);
-        cam.s = params_.perFrameScale ? s[i] : sGlobal;
+        cam.t = Vec3d(cams.t(i)[0] + Rc[0], cams.t(i)[1] + Rc[1], cam.t[2]);
+        cam.s = params_.perFrameScale ? *cams.extra(i) : sGlobal;
     }
     rec.points = X;
     return true;
@@ -372,8 +372,7 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
         if (rec.hasPoint(p))
             for (int k = 0; k < 3; k++)
                 X.at<double>(p, k) -= c[k];
-    std::vector<Eigen::Quaterniond> q(n);
-    std::vector<Vec3d> t(n);
+    detail::CameraBlocks cams(n, 3);  // q, t
     double s = 0, kappa = 0;
     double D0 = 0;
     if (rec.model == PERSPECTIVE)
@@ -388,18 +387,20 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     for (int i = 0; i < n; i++)
     {
         const Camera& cam = rec.cameras[i];
-        q[i] = detail::toQuaternion(cam.R);
+        cams.setRotation(i, cam.R);
         const Vec3d Rc = cam.R * c;
+        Vec3d ti;
         if (rec.model == PERSPECTIVE)
         {
-            t[i] = cam.t + Rc - Vec3d(0, 0, D0);
+            ti = cam.t + Rc - Vec3d(0, 0, D0);
             s += 0.5 * (cam.K(0, 0) + cam.K(1, 1)) * kappa / n;
         }
         else
         {
-            t[i] = Vec3d(cam.t[0] + Rc[0], cam.t[1] + Rc[1], 0.0);
+            ti = Vec3d(cam.t[0] + Rc[0], cam.t[1] + Rc[1], 0.0);
             s += cam.s / n;
         }
+        std::copy(ti.val, ti.val + 3, cams.t(i));
     }
     std::deque<detail::PerspectiveStrengthCost> costs;  // declared before the problem
     ceres::Problem problem(bundleProblemOptions());
@@ -410,16 +411,16 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     forEachObservationPointMajor(tracks, rec, used,
                                  [&](int i, int p, const Point2f& o, const Point2d& pp) {
         costs.emplace_back(o.x, o.y, pp.x, pp.y);
-        problem.AddResidualBlock(&costs.back(), loss.get(), q[i].coeffs().data(), t[i].val, &s,
+        problem.AddResidualBlock(&costs.back(), loss.get(), cams.q(i), cams.t(i), &s,
                                  &kappa, X.ptr<double>(p));
     });
     for (int i = 0; i < n; i++)
     {
-        if (problem.HasParameterBlock(q[i].coeffs().data()))
+        if (problem.HasParameterBlock(cams.q(i)))
         {
-            problem.SetManifold(q[i].coeffs().data(), &quatManifold);
-            ordering->AddElementToGroup(q[i].coeffs().data(), 1);
-            ordering->AddElementToGroup(t[i].val, 1);
+            problem.SetManifold(cams.q(i), &quatManifold);
+            ordering->AddElementToGroup(cams.q(i), 1);
+            ordering->AddElementToGroup(cams.t(i), 1);
         }
     }
     if (problem.NumResidualBlocks() == 0)
@@ -427,8 +428,8 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     ordering->AddElementToGroup(&s, 1);
     ordering->AddElementToGroup(&kappa, 1);
     // Gauge (similarity, 7 dof): the first camera's rotation and translation, and the zoom.
-    problem.SetParameterBlockConstant(q[0].coeffs().data());
-    problem.SetParameterBlockConstant(t[0].val);
+    problem.SetParameterBlockConstant(cams.q(0));
+    problem.SetParameterBlockConstant(cams.t(0));
     problem.SetParameterBlockConstant(&s);
     for (int p = 0; p < P; p++)
         if (used[p])
@@ -472,8 +473,8 @@ bool OrthoCameraRefinerImpl::refinePerspective(const Tracks& tracks, Reconstruct
     {
         Camera& cam = rec.cameras[i];
         const Point2d pp = cam.principalPoint();
-        Matx33d R = detail::fromQuaternion(q[i].coeffs().data());
-        Vec3d ti = t[i];
+        Matx33d R = cams.rotation(i);
+        Vec3d ti(cams.t(i)[0], cams.t(i)[1], cams.t(i)[2]);
         if (mirror)
         {
             R = Z * R * Z;
@@ -754,17 +755,13 @@ bool adjustLens(const Tracks& tracks, Reconstruction& rec, const LensFreedom& fr
     for (size_t k = 0; k < std::min<size_t>(12, c0.distortion.size()); k++)
         dist[k] = c0.distortion[k];
     const Matx33d tilt = tiltHomography(c0.distortion);
-    // Every pose in one buffer, camera after camera (quaternion x, y, z, w, then t): Ceres
-    // orders the blocks of an elimination group by their addresses, and poses in separate heap
-    // buffers (one for the rotations, one for the translations) came in an order that changed
-    // from run to run with the allocator's state, and with it the last digits of the solution.
-    std::vector<double> poses(7 * (size_t)n);
-    auto qd = [&](int i) { return &poses[7 * (size_t)i]; };
-    auto td = [&](int i) { return &poses[7 * (size_t)i + 4]; };
+    // Every pose in one buffer (detail::CameraBlocks: the blocks' order is the cameras').
+    detail::CameraBlocks poses(n, 3);
+    auto qd = [&](int i) { return poses.q(i); };
+    auto td = [&](int i) { return poses.t(i); };
     for (int i = 0; i < n; i++)
     {
-        const Eigen::Quaterniond qi = detail::toQuaternion(rec.cameras[i].R);
-        std::copy(qi.coeffs().data(), qi.coeffs().data() + 4, qd(i));
+        poses.setRotation(i, rec.cameras[i].R);
         std::copy(rec.cameras[i].t.val, rec.cameras[i].t.val + 3, td(i));
     }
     Mat X = rec.points.clone();

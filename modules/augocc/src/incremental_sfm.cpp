@@ -73,8 +73,6 @@ const int kGlobalBaIterations = 10;
 const int kFinalBaIterations = 50;
 // Observations per point up to which the adjustments use sparse Cholesky (see bundleAdjust).
 const double kNarrowBandObs = 6.0;
-// Parameters of one camera in the adjustments: quaternion (4), translation (2), zoom (1).
-const int kCamBlock = 7;
 
 inline Vec2d projectView(const OrthoView& v, const Point2d& pp, const double* X)
 {
@@ -406,20 +404,16 @@ void IncrementalBuilder::bundleAdjust(const std::vector<uchar>& variable, int it
             if (solvedPoint(idx_.byFrame[i].point))
                 pointUsed[idx_.byFrame[i].point] = 1;
     }
-    // Every camera's blocks in one array, frame by frame (quaternion x y z w, tx ty, s): Ceres
-    // orders the blocks of an elimination group by address, so that the summation order, and
-    // with it the result to the last bit, depends on the layout (separate heap arrays did not
-    // give the same result twice).
-    std::vector<double> cam((size_t)F * kCamBlock, 0.0);
-    auto q = [&](int f) { return &cam[(size_t)f * kCamBlock]; };
-    auto t = [&](int f) { return &cam[(size_t)f * kCamBlock + 4]; };
-    auto s = [&](int f) { return &cam[(size_t)f * kCamBlock + 6]; };
+    // Every camera's blocks in one buffer, frame by frame (CameraBlocks: q, tx ty, s), so that
+    // the blocks' order, and with it the result to the last bit, is the frames'.
+    CameraBlocks cam(F, 2, 1);
+    auto q = [&](int f) { return cam.q(f); };
+    auto t = [&](int f) { return cam.t(f); };
+    auto s = [&](int f) { return cam.extra(f); };
     for (int f = 0; f < F; f++)
         if (views_[f].solved)
         {
-            const Eigen::Quaterniond qf = toQuaternion(views_[f].R);
-            for (int k = 0; k < 4; k++)
-                q(f)[k] = qf.coeffs()[k];
+            cam.setRotation(f, views_[f].R);
             t(f)[0] = views_[f].t[0];
             t(f)[1] = views_[f].t[1];
             *s(f) = views_[f].s;

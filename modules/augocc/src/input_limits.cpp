@@ -581,9 +581,11 @@ struct PlyProperty
     bool list = false;
     int countSize = 0;  // bytes of the list count (binary)
     bool countSigned = false;
+    bool indexSigned = false;
     bool isIndex = false;
     bool isFloat = false;
     bool isCoordinate = false;  // vertex x, y or z
+    String name;
 };
 
 struct PlyElement
@@ -637,7 +639,15 @@ void checkPly(const char* data, size_t size, const String& where)
         String word;
         ls >> word;
         if (word == "format")
-            ls >> format;
+        {
+            String version;
+            ls >> format >> version;
+            if (version != "1.0")
+                CV_Error(Error::StsParseError, where + ": PLY header: bad line '" + line +
+                         "' (format ascii|binary_little_endian|binary_big_endian 1.0)");
+        }
+        else if (word == "ply" || word == "comment" || word == "obj_info")
+            continue;
         else if (word == "element")
         {
             PlyElement e;
@@ -664,12 +674,20 @@ void checkPly(const char* data, size_t size, const String& where)
             {
                 String ct, it, name;
                 ls >> ct >> it >> name;
+                p.name = name;
                 p.list = true;
                 p.countSize = plyTypeSize(ct);
                 p.countSigned = ct == "char" || ct == "short" || ct == "int" || ct == "int8" ||
                                 ct == "int16" || ct == "int32";
                 p.size = plyTypeSize(it);
-                p.isIndex = elems.back().name == "face";
+                p.indexSigned = it == "char" || it == "short" || it == "int" || it == "int8" ||
+                                it == "int16" || it == "int32";
+                p.isIndex = elems.back().name == "face" &&
+                            (name == "vertex_indices" || name == "vertex_index");
+                if (p.isIndex && (it == "float" || it == "float32" || it == "double" ||
+                                  it == "float64"))
+                    CV_Error(Error::StsParseError, where + ": PLY header: vertex indices of "
+                             "floating-point type in '" + line + "'");
                 if (!p.countSize || !p.size || p.countSize > 4)
                     CV_Error(Error::StsParseError, where + ": PLY header: bad line '" + line + "'");
             }
@@ -677,6 +695,7 @@ void checkPly(const char* data, size_t size, const String& where)
             {
                 String name;
                 ls >> name;
+                p.name = name;
                 p.size = plyTypeSize(t);
                 if (!p.size)
                     CV_Error(Error::StsParseError, where + ": PLY header: unknown type in '" +
@@ -687,14 +706,36 @@ void checkPly(const char* data, size_t size, const String& where)
             }
             elems.back().props.push_back(p);
         }
+        else
+        {
+            // A line Assimp's loader reads differently from the element layout (a misspelt
+            // "property") made it read past its buffers and leak (fuzz_mesh): the PLY header
+            // has no other keywords.
+            CV_Error(Error::StsParseError, where + ": PLY header: unknown line '" + line +
+                     "' (ply, format, comment, obj_info, element, property, end_header)");
+        }
     }
     if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
         CV_Error(Error::StsParseError, where + ": PLY header: format must be ascii, "
                  "binary_little_endian or binary_big_endian");
     int64 vertices = -1;
     for (const PlyElement& e : elems)
+    {
         if (e.name == "vertex")
+        {
             vertices = e.count;
+            // Assimp's post-processing dereferenced the missing axis of a vertex without y.
+            for (const char* axis : {"x", "y", "z"})
+                if (std::none_of(e.props.begin(), e.props.end(), [&](const PlyProperty& q) {
+                        return !q.list && q.name == axis; }))
+                    CV_Error(Error::StsParseError, where + ": PLY vertex element has no '" +
+                             String(axis) + "' property");
+        }
+        for (const PlyProperty& q : e.props)
+            if (q.name.empty())
+                CV_Error(Error::StsParseError, where + ": PLY header: a property of element '" +
+                         e.name + "' has no name");
+    }
     // A header without its vertex element made Assimp's PLY loader loop for ever (fuzz_mesh).
     if (vertices < 0)
         CV_Error(Error::StsParseError, where + ": PLY header declares no 'element vertex'");
@@ -710,6 +751,13 @@ void checkPly(const char* data, size_t size, const String& where)
     auto badIndex = [&](double v, int64 k) {
         CV_Error(Error::StsParseError, where + cv::format(": PLY face %lld refers to vertex %.0f "
                  "of %lld", (long long)k, v, (long long)vertices));
+    };
+    // A face of no corner crashed Assimp's post-processing (fuzz_mesh); one or two corners are
+    // points and lines, not surfaces.
+    auto tooFewCorners = [&](double n, int64 k) {
+        if (n < 3)
+            CV_Error(Error::StsParseError, where + cv::format(": PLY face %lld has %.0f "
+                     "corners (at least 3)", (long long)k, n));
     };
     auto badVertex = [&](double v, int64 k) {
         if (!(std::abs(v) <= kMaxSceneCoordinate))
@@ -745,6 +793,8 @@ void checkPly(const char* data, size_t size, const String& where)
                     {
                         if (!next(v) || v < 0 || v > 1024 || v != std::floor(v))
                             truncated(e, k);
+                        if (pr.isIndex)
+                            tooFewCorners(v, k);
                         for (int q = 0; q < (int)v; q++)
                         {
                             double idx;
@@ -801,15 +851,23 @@ void checkPly(const char* data, size_t size, const String& where)
                     p += pr.countSize;
                     if ((uint64_t)(end - p) < cnt * (uint64_t)pr.size)
                         truncated(e, k);
-                    if (pr.isIndex && pr.size == 4)
-                        for (uint64_t q = 0; q < cnt; q++)
+                    if (pr.isIndex)
+                    {
+                        tooFewCorners((double)cnt, k);
+                        // Indices of any integer type (1, 2 or 4 bytes; signed or not).
+                        for (uint64_t q = 0; q < cnt && pr.size <= 4; q++)
                         {
-                            uint32_t idx = 0;
-                            for (int b = 0; b < 4; b++)
-                                idx = (idx << 8) | (uchar)p[q * 4 + (little ? 3 - b : b)];
-                            if ((int64)(int32_t)idx < 0 || (int64)idx >= vertices)
-                                badIndex((double)(int32_t)idx, k);
+                            uint64_t u = 0;
+                            for (int b = 0; b < pr.size; b++)
+                                u = (u << 8) |
+                                    (uchar)p[q * pr.size + (little ? pr.size - 1 - b : b)];
+                            int64 idx = (int64)u;
+                            if (pr.indexSigned && (u >> (8 * pr.size - 1)) & 1)
+                                idx -= (int64)1 << (8 * pr.size);
+                            if (idx < 0 || idx >= vertices)
+                                badIndex((double)idx, k);
                         }
+                    }
                     p += cnt * pr.size;
                 }
             }

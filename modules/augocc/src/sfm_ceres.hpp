@@ -349,6 +349,31 @@ of the 10% default and reached a lower cost. */
 const double kBundleForcing = 1e-3;
 const int kBundleMaxCgSteps = 50;
 
+/** @brief Every camera's parameter blocks of a bundle adjustment in ONE buffer, camera after
+camera: the quaternion (x, y, z, w) at offset 0, then the translation (`tSize` values), then
+`extra` values (a per-frame zoom). Ceres orders the blocks of an elimination group by address
+(ParameterBlockOrdering keeps a std::set<double*>), and through the ordering the sparse
+factorisation and the summation order: blocks in separate heap buffers (one for the rotations,
+one for the translations) came in an order that changed with the allocator's state, and with
+it the last digits of the solution from call to call. One buffer makes the order the cameras'
+and the result reproducible to the bit. */
+class CameraBlocks
+{
+public:
+    CameraBlocks(int cameras, int tSize, int extra = 0)
+        : stride_(4 + tSize + extra), tSize_(tSize), data_((size_t)cameras * stride_, 0.0) {}
+    double* q(int i) { return &data_[(size_t)i * stride_]; }
+    double* t(int i) { return &data_[(size_t)i * stride_ + 4]; }
+    double* extra(int i) { return &data_[(size_t)i * stride_ + 4 + tSize_]; }
+    //! Stores the rotation R of camera i as its unit quaternion.
+    void setRotation(int i, const Matx33d& R);
+    //! The rotation of camera i (its quaternion normalised).
+    Matx33d rotation(int i) const;
+private:
+    int stride_, tSize_;
+    std::vector<double> data_;
+};
+
 //! Unit quaternion of a rotation matrix.
 inline Eigen::Quaterniond toQuaternion(const Matx33d& R)
 {
@@ -372,6 +397,17 @@ inline Matx33d fromQuaternion(const double* xyzw)
         for (int c = 0; c < 3; c++)
             R(r, c) = m(r, c);
     return R;
+}
+
+inline void CameraBlocks::setRotation(int i, const Matx33d& R)
+{
+    const Eigen::Quaterniond qi = toQuaternion(R);
+    std::copy(qi.coeffs().data(), qi.coeffs().data() + 4, q(i));
+}
+
+inline Matx33d CameraBlocks::rotation(int i) const
+{
+    return fromQuaternion(&data_[(size_t)i * stride_]);
 }
 
 /** @brief Reports a solve's iterations to the stage's progress (ProgressScope::current()) as
