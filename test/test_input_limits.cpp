@@ -149,6 +149,17 @@ TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
              [&] { readTracks(f); }, [&] { readReconstruction(f); },
              [&] { readCalibration(f); }, [&] { CloneSet::load(f); }, [&] { readScene(f); }})
         EXPECT_TRUE(throwsWith(read, {f}));
+    // Found by fuzz_scene: an indented sequence at the top, then a line starting with '-', made
+    // FileStorage::open loop for ever (the whole finding, and the 3-line core of it).
+    const std::string hang = dataFile("fuzz_scene_filestorage_hang.yml");
+    EXPECT_TRUE(throwsWith([&] { readScene(hang); }, {hang, "line 2", "top-level key"}));
+    const std::string core = dir + "/core.yml";
+    writeText(core, "%YAML:1.0\n  - name: x\n-x--\n");
+    for (auto read : std::vector<std::function<void()> >{
+             [&] { readTracks(core); }, [&] { readReconstruction(core); },
+             [&] { readCalibration(core); }, [&] { CloneSet::load(core); },
+             [&] { readScene(core); }})
+        EXPECT_TRUE(throwsWith(read, {core, "top-level key"}));
     fs::remove_all(dir);
 }
 

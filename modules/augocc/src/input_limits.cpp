@@ -373,6 +373,43 @@ String readWhole(const String& path, int64 limit, const String& what)
     return s;
 }
 
+// OpenCV 4.6's YAML parser never returned on a top level that is an indented sequence of maps
+// followed by a line starting with '-' ("  - name: x" then "-x--": fuzz_scene,
+// fuzz/open_findings). Every augocc file is a map at the top, written with its keys at the start
+// of the line, as FileStorage writes it: the first line of content (after the "%YAML" directive,
+// "---", comments and blank lines) must start with a key, not with a space or '-'.
+void checkYamlTopLevel(const std::string& text, const String& path, const String& what)
+{
+    size_t i = 0;
+    while (i < text.size() && (text[i] == ' ' || text[i] == '\t' || text[i] == '\r' ||
+                               text[i] == '\n'))
+        i++;
+    if (i < text.size() && (text[i] == '{' || text[i] == '<'))
+        return;  // JSON or XML
+    size_t start = 0;
+    int line = 0;
+    while (start < text.size())
+    {
+        size_t end = text.find('\n', start);
+        if (end == std::string::npos)
+            end = text.size();
+        line++;
+        std::string l = text.substr(start, end - start);
+        if (!l.empty() && l.back() == '\r')
+            l.pop_back();
+        start = end + 1;
+        const size_t first = l.find_first_not_of(" \t");
+        if (first == std::string::npos || l[0] == '%' || l[first] == '#' ||
+            l.compare(0, 3, "---") == 0)
+            continue;
+        if (first != 0 || l[0] == '-')
+            CV_Error(Error::StsParseError, path + cv::format(": %s: line %d ('%s') must start "
+                     "a top-level key at the start of the line (the file's top level is a map)",
+                     what.c_str(), line, l.substr(0, 40).c_str()));
+        return;
+    }
+}
+
 } // namespace
 
 int storageNestingDepth(const char* data, size_t size, int stopAt)
@@ -418,6 +455,7 @@ void checkStorageFile(const String& path, const String& what)
         CV_Error(Error::StsParseError, path + cv::format(": %s holds a NUL byte at offset %zu "
                  "(binary data, not a YAML, JSON or XML text)", what.c_str(),
                  (size_t)((const char*)std::memchr(text.data(), 0, text.size()) - text.data())));
+    checkYamlTopLevel(text, path, what);
     const int depth = storageNestingDepth(text.data(), text.size(), kMaxStorageDepth);
     if (depth > kMaxStorageDepth)
         CV_Error(Error::StsOutOfRange, path + cv::format(": %s nests deeper than augocc's limit "
