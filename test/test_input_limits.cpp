@@ -135,6 +135,14 @@ TEST(Augocc_InputLimits, regression_fuzz_reconstruction_length_error)
     EXPECT_TRUE(throwsWith([&] { readReconstruction(f); }, {f, "cannot parse file"}));
 }
 
+// Every FileStorage reader of augocc, reading `path`.
+std::vector<std::function<void()> > storageReaders(const std::string& path)
+{
+    return {[=] { readTracks(path); }, [=] { readReconstruction(path); },
+            [=] { readCalibration(path); }, [=] { CloneSet::load(path); },
+            [=] { readScene(path); }};
+}
+
 TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
 {
     // Found by fuzz_tracks: NUL bytes in a tracks file made FileStorage::open loop for ever.
@@ -145,9 +153,7 @@ TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
     const std::string dir = tempDir("limits_top");
     const std::string f = dir + "/seq.yml";
     writeText(f, "%YAML:1.0\n---\n- 1\n- 2\n");
-    for (auto read : std::vector<std::function<void()> >{
-             [&] { readTracks(f); }, [&] { readReconstruction(f); },
-             [&] { readCalibration(f); }, [&] { CloneSet::load(f); }, [&] { readScene(f); }})
+    for (const auto& read : storageReaders(f))
         EXPECT_TRUE(throwsWith(read, {f}));
     // Found by fuzz_scene: an indented sequence at the top, then a line starting with '-', made
     // FileStorage::open loop for ever (the whole finding, and the 3-line core of it).
@@ -155,10 +161,7 @@ TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
     EXPECT_TRUE(throwsWith([&] { readScene(hang); }, {hang, "line 2", "top-level key"}));
     const std::string core = dir + "/core.yml";
     writeText(core, "%YAML:1.0\n  - name: x\n-x--\n");
-    for (auto read : std::vector<std::function<void()> >{
-             [&] { readTracks(core); }, [&] { readReconstruction(core); },
-             [&] { readCalibration(core); }, [&] { CloneSet::load(core); },
-             [&] { readScene(core); }})
+    for (const auto& read : storageReaders(core))
         EXPECT_TRUE(throwsWith(read, {core, "top-level key"}));
     fs::remove_all(dir);
 }
