@@ -159,6 +159,10 @@ TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
     // FileStorage::open loop for ever (the whole finding, and the 3-line core of it).
     const std::string hang = dataFile("fuzz_scene_filestorage_hang.yml");
     EXPECT_TRUE(throwsWith([&] { readScene(hang); }, {hang, "line 2", "top-level key"}));
+    // And a document marker with text glued to it, then a sequence ("---Y:1", "ts:", "  -").
+    const std::string marker = dataFile("fuzz_scene_marker_hang.yml");
+    EXPECT_TRUE(throwsWith([&] { readScene(marker); },
+                           {marker, "line 2", "'---' document marker"}));
     const std::string core = dir + "/core.yml";
     writeText(core, "%YAML:1.0\n  - name: x\n-x--\n");
     for (const auto& read : storageReaders(core))
@@ -279,6 +283,15 @@ TEST(Augocc_InputLimits, regression_mesh_cut_in_header_and_body)
                            {"fuzz_mesh_misspelt_property.ply", "bad line 'format ascii 1.`0'"}));
     EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_garbled_keyword.ply")); },
                            {"fuzz_mesh_garbled_keyword.ply", "unknown line"}));
+    // "pLy" and no end_header: Assimp's detection ignores case, and it looped for ever.
+    EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_mixed_case_magic.ply")); },
+                           {"fuzz_mesh_mixed_case_magic.ply", "end_header"}));
+    // A NUL inside an ASCII body's line: SIGSEGV in Assimp's post-processing.
+    EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_nul_in_ascii_body.ply")); },
+                           {"fuzz_mesh_nul_in_ascii_body.ply", "control byte 0x00"}));
+    // A form feed in a header line ("element face 03\fproperty list ..."): SIGSEGV likewise.
+    EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_form_feed_in_header.ply")); },
+                           {"fuzz_mesh_form_feed_in_header.ply", "control byte 0x0c"}));
     // A binary face of no corner: SIGSEGV in Assimp's post-processing.
     EXPECT_TRUE(throwsWith([] { loadMeshes(dataFile("fuzz_mesh_face_without_corners.ply")); },
                            {"fuzz_mesh_face_without_corners.ply", "face 0 has 0 corners"}));
