@@ -5,6 +5,7 @@
 
 #include "frame_pattern.hpp"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -511,6 +512,39 @@ TEST(Augocc_WriteAtomically, regression_stale_temporaries)
     m["obj"][0] = Mat::zeros(4, 4, CV_8U);
     writeMasks(dir + "/masks", m);
     EXPECT_FALSE(fs::exists(dir + "/.masks.tmp17"));
+}
+
+TEST(Augocc_WriteAtomically, regression_zombie_writer_is_dead)
+{
+    // A writer killed with its parent stays a zombie where PID 1 does not reap orphans (CI's
+    // micro-VM): kill(pid, 0) succeeds on it, yet its temporary is stale. Made here as a child
+    // that exits and is not waited for until the sweep has run.
+    const std::string dir = tempDir("io");
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0)
+        _exit(0);
+    // The child is a zombie once its state in /proc says so (it exits at once).
+    const std::string stat = "/proc/" + std::to_string(child) + "/stat";
+    bool zombie = false;
+    for (int i = 0; i < 500 && !zombie; ++i)
+    {
+        std::ifstream in(stat);
+        std::string line;
+        std::getline(in, line);
+        const size_t close = line.rfind(')');
+        zombie = close != std::string::npos && close + 2 < line.size() && line[close + 2] == 'Z';
+        if (!zombie)
+            usleep(2000);
+    }
+    const std::string name = cv::format(".tracks.tmp%d-1.yml", (int)child);
+    writeText(dir, name, "half a file");
+    writeTracks(dir + "/tracks.yml", makeTracks(4, 5));
+    const bool swept = !fs::exists(dir + "/" + name);
+    int status = 0;
+    waitpid(child, &status, 0);
+    ASSERT_TRUE(zombie) << "the child never showed as a zombie in " << stat;
+    EXPECT_TRUE(swept) << name << " kept: its writer is a zombie, not at work";
 }
 
 TEST(Augocc_WriteAtomically, bad_arg)

@@ -79,12 +79,29 @@ check_same() {
         "$T/shot/composite.mp4")" = "$(ffprobe -v error -select_streams v:0 \
         -show_entries stream=codec_name -of csv=p=0 "$T/ref.mp4")" ] ||
         fail "$what: the joined video's codec differs from the single-machine one"
-    # The decoded frames, in order: one encode of the same frames with the same encoder and
-    # settings (x264 is deterministic), so equal hashes, no tolerance needed.
-    ffmpeg -y -v error -i "$T/ref.mp4" -f framemd5 "$T/ref.md5"
-    ffmpeg -y -v error -i "$T/shot/composite.mp4" -f framemd5 "$T/joined.md5"
-    diff <(grep -v '^#' "$T/ref.md5") <(grep -v '^#' "$T/joined.md5") >/dev/null ||
-        fail "$what: the joined video's decoded frames differ from the single-machine video's"
+    # The decoded frames, in order, as faithful to the lossless frames as the single-machine
+    # video. Not hash-equal: OpenCV 4.6's H.264 writer (x264, frame threads) does not give the
+    # same bytes twice for the same frames when the process is busy (measured: 3 runs of one
+    # `composite --out x.mp4`, 2 distinct videos, PSNR 42-46 dB between them). So: per frame,
+    # PSNR of each video against the joined PNG frame k; the joined video's within 1 dB of the
+    # single-machine one's (two encodes differ by <= 0.1 dB here; x264's own error is ~40 dB),
+    # and >= 30 dB (a wrong or shifted frame scores ~20 dB against frame k).
+    psnr_of() {
+        ffmpeg -v error -framerate 25 -pattern_type glob -i "$T/shot/composite/*.png" -i "$1" \
+            -lavfi "[0:v]format=yuv420p[a];[a][1:v]psnr=stats_file=$2" -f null - ||
+            fail "$what: cannot compare $1 with the PNG frames"
+    }
+    psnr_of "$T/ref.mp4" "$T/ref.psnr"
+    psnr_of "$T/shot/composite.mp4" "$T/joined.psnr"
+    local bad
+    bad=$(paste -d' ' "$T/ref.psnr" "$T/joined.psnr" | awk '{
+        for (i = 1; i <= NF; i++) if ($i ~ /^psnr_avg:/) { split($i, a, ":"); v[++n] = a[2] }
+        r = v[n - 1]; j = v[n]; n = 0
+        if (r == "inf") r = 99; if (j == "inf") j = 99
+        if (j < 30 || j < r - 1) printf "frame %d: joined %.2f dB, single machine %.2f dB; ", NR - 1, j, r
+    }')
+    [ "$(wc -l <"$T/joined.psnr")" = 16 ] || fail "$what: the video comparison saw $(wc -l <"$T/joined.psnr") frames"
+    [ -z "$bad" ] || fail "$what: the joined video's frames are less faithful than the single-machine video's: $bad"
     echo "$what: joined outputs = single-machine outputs (16 frames)"
 }
 check_same "4 chunks"

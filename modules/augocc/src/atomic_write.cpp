@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <zlib.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -97,7 +98,20 @@ bool processAlive(long pid)
 {
     if (pid <= 0 || pid != (long)(pid_t)pid)
         return false;
-    return ::kill((pid_t)pid, 0) == 0 || errno == EPERM;
+    if (::kill((pid_t)pid, 0) != 0 && errno != EPERM)
+        return false;
+    // A killed writer whose parent died too stays a zombie where PID 1 does not reap orphans
+    // (containers, micro-VMs): kill(pid, 0) still succeeds. Its state in /proc says it is dead.
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string line;
+    if (!std::getline(stat, line))
+        return true;  // no /proc: trust kill()
+    // "PID (COMM) STATE ...": COMM may hold spaces and parentheses, so the last ')' ends it.
+    const size_t close = line.rfind(')');
+    if (close == std::string::npos || close + 2 >= line.size())
+        return true;
+    const char state = line[close + 2];
+    return state != 'Z' && state != 'X' && state != 'x';
 }
 
 // The folder that holds `path` ("." for a bare name).
