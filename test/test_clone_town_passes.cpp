@@ -203,6 +203,10 @@ void printLosses(const char* tag, const std::map<String, ObjectLosses>& losses)
 
 typedef testing::TestWithParam<int> Augocc_CloneBuilder_Town;
 
+// Sampling: 4000 volume samples per object, so one lost sample is 0.00025.
+const double kMaxDeepLoss = 0.001;
+const double kMaxUnobservedDeepLoss = 0.07;
+
 TEST_P(Augocc_CloneBuilder_Town, pass_diagnostic)
 {
     const CameraModel model = (CameraModel)GetParam();
@@ -215,12 +219,75 @@ TEST_P(Augocc_CloneBuilder_Town, pass_diagnostic)
         const String tag = cv::format("[town %s %s]", sceneId ? "town" : "mushroom",
                                       cameraModelName(model).c_str());
         printLosses(tag.c_str(), losses);
+        for (const auto& o : losses)
+        {
+            SCOPED_TRACE(tag + " " + o.first);
+            // Steps 1-4 and the growth keep every voxel deeper than 1.5 voxels inside the true
+            // object (exact cameras: the visual hull holds it; measured 0 since the trimmed box
+            // gives back its contiguous points). Before, the box cut 1.2% / 1.5% of the tower.
+            for (int p = 0; p < 3; p++)
+                EXPECT_LE(o.second.pass[p].deepLost, kMaxDeepLoss) << kPassNames[p];
+            // The unobserved runs are not bounded here: they remove 17-49% of the true volume of
+            // every object but the border shed and the house (interior runs under a top seen at a
+            // grazing angle, whose voxels fall outside the 1.5-voxel depth tolerance of the
+            // nearest footprint; no matte changes). Open (issue 18, doc/clones.md).
+        }
         for (const TownObject& o : s.objects)
         {
             const TownFigures f = measureTown(*clones, s, o.name);
             std::cout << tag << " " << o.name << cv::format(": key min %.4f, non-key mean %.4f "
                       "worst %.4f (frame %d), recall min %.4f (frame %d)", f.keyMin, f.nonKeyMean,
                       f.nonKeyMin, f.worstFrame, f.recallMin, f.recallFrame) << std::endl;
+        }
+    }
+}
+
+// Issue 18's targets (true cameras, 6 key frames, silhouettes only): non-key mean IoU >= 0.98 and
+// worst >= 0.95 for unhidden objects, mean >= 0.97 for hidden ones, recall >= 0.995 in every
+// non-key frame. Measured 2026-12-02 (orthographic / perspective): the mushroom tower (hidden)
+// 0.985 / 0.983, recall min 0.9970 / 0.9941 (before the box fix 0.979 / 0.975, 0.9879 / 0.9897);
+// the box in front of it 0.983 / 0.981, worst 0.965 / 0.964, recall min 0.9960 / 0.9941. Not met
+// yet, bounded below at the measured figures less about 0.005 so that they cannot fall unseen: the
+// other objects' non-key mean (silo 0.972 / 0.976, house 0.982 / 0.980, hillside 0.980 / 0.958,
+// arch 0.972, border 0.969 / 0.979: the visual hull between key frames 14 degrees apart), worst
+// frame (hillside 0.860 perspective, arch 0.924, border 0.915) and recall (arch 0.962, silo 0.978,
+// border 0.969: carving keeps a voxel only when its whole footprint is in a silhouette, so a ring
+// of about a pixel goes in the frames between key frames, where only the nearest key frame's
+// patches help).
+const double kTownMeanIoU = 0.98, kTownMinIoU = 0.95, kTownHiddenMeanIoU = 0.97;
+const double kTowerRecall = 0.994;  // target 0.995, met orthographic (0.9970); perspective 0.9941
+const double kFrontRecall = 0.993;  // target 0.995; measured 0.9941 (perspective)
+const double kTownFloorMean = 0.95, kTownFloorMin = 0.855, kTownFloorRecall = 0.955;
+
+TEST_P(Augocc_CloneBuilder_Town, accuracy)
+{
+    const CameraModel model = (CameraModel)GetParam();
+    for (int sceneId = 0; sceneId < 2; sceneId++)
+    {
+        const TownScene s = sceneId == 0 ? mushroomScene(model) : townScene(model);
+        Ptr<CloneSet> clones = CloneBuilder::create()->build(s.rec, s.keyMasks);
+        for (const TownObject& o : s.objects)
+        {
+            const TownFigures f = measureTown(*clones, s, o.name);
+            SCOPED_TRACE(cameraModelName(model) + " " + o.name);
+            EXPECT_GE(f.keyMin, kKeyFrameMinIoU);
+            if (o.name == "tower")
+            {
+                EXPECT_GE(f.nonKeyMean, kTownHiddenMeanIoU);
+                EXPECT_GE(f.recallMin, kTowerRecall);
+            }
+            else if (o.name == "front")
+            {
+                EXPECT_GE(f.nonKeyMean, kTownMeanIoU);
+                EXPECT_GE(f.nonKeyMin, kTownMinIoU);
+                EXPECT_GE(f.recallMin, kFrontRecall);
+            }
+            else
+            {
+                EXPECT_GE(f.nonKeyMean, kTownFloorMean);
+                EXPECT_GE(f.nonKeyMin, kTownFloorMin);
+                EXPECT_GE(f.recallMin, kTownFloorRecall);
+            }
         }
     }
 }
