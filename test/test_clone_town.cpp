@@ -263,7 +263,8 @@ TownScene makeTownScene(CameraModel model, const std::vector<TownObject>& object
 std::vector<TownObject> mushroomObjects()
 {
     // The held-out town's tower (issue 18): stem r 0.55, cap r 1.5.
-    TownObject tower{"tower", {cylinderPrism(0, 0, 0.55, 0, 2.4), cylinderPrism(0, 0, 1.5, 2.4, 3.0)}};
+    TownObject tower{"tower", {cylinderPrism(0, 0, 0.55, 0, 2.4),
+                               cylinderPrism(0, 0, 1.5, 2.4, 3.0)}};
     // Between the tower and the last frames' cameras (azimuth +35: direction (0.57, 0, 0.82)).
     TownObject front{"front", {boxPrism(Vec3d(1.2, 0, 2.4), Vec3d(3.2, 1.4, 3.4))}};
     TownObject silo{"silo", {cylinderPrism(-3.8, -1.0, 0.8, 0, 2.6)}};
@@ -314,7 +315,8 @@ TownFigures measureTown(const CloneSet& clones, const TownScene& s, const String
         }
         const Mat& whole = s.whole.at(object).at(cam.frame);
         const double iou = maskIoU(matte, whole);
-        const double recall = (double)countNonZero(matte & whole) / std::max(1, countNonZero(whole));
+        const double recall =
+            (double)countNonZero(matte & whole) / std::max(1, countNonZero(whole));
         fig.nonKeyMean += iou;
         if (iou < fig.nonKeyMin)
         {
