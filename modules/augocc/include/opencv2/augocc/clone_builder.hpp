@@ -106,7 +106,9 @@ public:
         //! Step 1: fewer clustered points than this and the box comes from the silhouettes alone.
         int minPoints = 4;
         //! Step 1: fraction of the points trimmed at each end of every box axis, in [0, 0.5).
-        //! Higher gives a smaller box for Step 3 to enlarge.
+        //! Higher gives a smaller box for Step 3 to enlarge. At a box face that no key frame sees
+        //! (the bottom, for cameras above the ground) the trimmed points that continue the rest
+        //! (gaps up to 10% of the trimmed extent) are given back: Step 3 cannot restore that side.
         double trimFraction = 0.02;
         //! Step 2: an Orientation.
         int orientation = ORIENT_AUTO;
