@@ -14,6 +14,9 @@ PACKAGES=(
     libgtest-dev libgmock-dev googletest  # unit and accuracy tests
     libbenchmark-dev                      # perf suite
     python3                               # perf comparison and contact-sheet scripts (stdlib only)
+    python3-dev pybind11-dev              # `import augocc`: the Python module (modules/augocc/python)
+    python3-numpy python3-pytest          # its arrays and its tests (test/python, through CTest)
+    python3-opencv                        # cv2 in those tests; augocc.error subclasses cv2.error
     xvfb xdotool                          # end-to-end test of the interactive annotate tool
     ffmpeg                                # ffprobe for video checks in tests; ffmpeg for synth --bitrate
     doxygen texlive-base                  # API docs and their test (bibtex for @cite)
