@@ -172,6 +172,10 @@ ShotData checkShot(const Reconstruction& rec, const BlenderShotOptions& o)
                      format(" is %dx%d: they do not belong together", rec.imageSize.width,
                             rec.imageSize.height));
     }
+    if (rec.cameras.back().frame >= count)
+        CV_Error(Error::StsBadArg, o.footage + format(": the input has %d frames but ", count) +
+                 recName + format(" has a camera for frame %d: they do not belong together",
+                                  rec.cameras.back().frame));
     if (o.fps > 0)
         d.fps = o.fps;
     d.first = o.firstFrame;

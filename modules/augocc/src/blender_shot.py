@@ -115,6 +115,9 @@ def setup_scene():
     scene.render.engine = 'CYCLES'
     scene.cycles.device = 'CPU'
     scene.cycles.samples = SHOT['samples']
+    # Debian's Blender 3.4 is built without OpenImageDenoise, and Cycles then refuses to render
+    # with denoising on ("Build without OpenImageDenoiser"): off; turn it on where Blender has it.
+    scene.cycles.use_denoising = False
     scene.render.resolution_x = SHOT['width']
     scene.render.resolution_y = SHOT['height']
     scene.render.resolution_percentage = 100
@@ -234,15 +237,19 @@ def add_compositor(scene, clip):
 
 def add_clones(scene, world):
     """The real objects' clones as holdouts: the trimmed model always, each key frame's patch
-    voxels in the frames whose patch set holds it."""
+    voxels in the frames whose patch set holds it. They cast no shadow: the real objects'
+    shadows are in the footage already, and the shadow catcher would add them a second time
+    (Blender 3.4 has no light linking to keep only their shadows on the virtual objects)."""
     frames = range(SHOT['first_frame'], SHOT['end_frame'])
     for c in SHOT['clones']:
         ob = mesh_object('clone_' + c['name'], c['file'], world)
         ob.is_holdout = True
+        ob.visible_shadow = False
         for p in c['patches']:
             po = mesh_object('clone_%s_patches_%04d' % (c['name'], p['key_frame']), p['file'],
                              world)
             po.is_holdout = True
+            po.visible_shadow = False
             shown = set(p['frames'])
             previous = None
             for f in frames:
