@@ -1,9 +1,11 @@
-# An overview of the shot: the clones shown (grey), the ground, the virtual objects, the shot's
-# camera drawn as a frustum, seen from a second camera behind and above it.
+# This file is part of augocc. License: Apache-2.0.
+# The picture of doc/blender.md (left half): the shot built by an exported shot.py seen from a
+# second camera, with the clones shown grey (not holdout) on a visible ground. Frame 4 of the
+# test's orthographic shot (test/blender/blender_test.sh); writes /tmp/bt/overview.png.
+# Usage: blender -b -P shot.py -P tools/blender_overview.py
 import bpy, mathutils
 s = bpy.context.scene
 s.frame_set(5)
-cam = s.camera
 s.render.use_compositing = False
 s.render.film_transparent = False
 s.world.color = (0.15, 0.17, 0.22)
