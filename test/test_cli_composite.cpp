@@ -424,5 +424,72 @@ TEST_F(Augocc_CliRun, bad_input_options_before_tracking)
                                  {"--threads"}, out_));
 }
 
+// `augocc export-blender`: the script and its assets from the valid data set; bad inputs exit 2
+// naming the file or flag, and leave neither a script nor an assets folder behind.
+String exportArgs(const String& input, const String& rec, const String& scene, const String& out,
+                  const String& extra = "")
+{
+    const CliData& d = cliData();
+    return "--quiet export-blender --input " + q(input) + " --reconstruction " + q(rec) +
+           " --clones " + q(d.clones) + " --scene " + q(scene) + " --out " + q(out) + " " + extra;
+}
+
+TEST_F(Augocc_CliComposite, export_blender_writes_script_and_assets)
+{
+    const CliData& d = cliData();
+    const String script = (fs::path(out_) / "shot.py").string();
+    String output;
+    ASSERT_EQ(0, runCommand(augoccBinary() + " " +
+                                exportArgs(d.frames, d.rec, d.scene, script, "--frames 1:4"),
+                            &output))
+        << output;
+    std::ifstream f(script);
+    const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    // One keyframe entry per frame of 1:4, the footage's first image, the clones as holdouts.
+    EXPECT_EQ(3, [&] {
+        int n = 0;
+        for (size_t p = text.find("\"frame\": "); p != std::string::npos;
+             p = text.find("\"frame\": ", p + 1))
+            n++;
+        return n;
+    }());
+    EXPECT_NE(std::string::npos, text.find("frames/0000.png"));
+    EXPECT_NE(std::string::npos, text.find("is_holdout = True"));
+    for (const String& o : CloneSet::load(d.clones)->objectNames())
+        EXPECT_TRUE(fs::exists(fs::path(out_) / "shot_assets" / "clones" / (o + "_clone.ply")))
+            << o;
+    EXPECT_TRUE(fs::exists(fs::path(out_) / "shot_assets" / "objects" / "tree_0.ply"));
+}
+
+TEST_F(Augocc_CliComposite, export_blender_bad_input)
+{
+    const CliData& d = cliData();
+    const String script = out_ + "/shot.py";
+    EXPECT_TRUE(badInputRejected(exportArgs(d.frames, d.rec, d.scene, script, "--frames 4:9"),
+                                 {"frames 4:9", "out of range"}, out_));
+    EXPECT_TRUE(badInputRejected(exportArgs(d.frames, d.rec, d.scene, out_ + "/shot.txt"),
+                                 {"--out", "shot.txt"}, out_));
+    EXPECT_TRUE(badInputRejected(exportArgs(d.frames, d.rec, d.scene, script, "--save x.png"),
+                                 {"--save", "x.png"}, out_));
+    EXPECT_TRUE(badInputRejected(exportArgs(d.frames, d.rec, out_ + "/../none.yml", script),
+                                 {"--scene", "none.yml"}, out_));
+    const String in = tempDir("in");
+    Reconstruction big = readReconstruction(d.rec);
+    big.imageSize = Size(2 * big.imageSize.width, 2 * big.imageSize.height);
+    writeReconstruction(in + "/big.yml", big);
+    EXPECT_TRUE(badInputRejected(exportArgs(d.frames, in + "/big.yml", d.scene, script),
+                                 {"big.yml"}, out_));
+    // Lens distortion Blender has no model of (a rational term, k4).
+    Reconstruction persp = readReconstruction(d.rec);
+    persp.model = PERSPECTIVE;
+    for (Camera& c : persp.cameras)
+        c = Camera::perspective(c.R, c.t + Vec3d(0, 0, 1e3),
+                                Matx33d(1e3 * c.s, 0, c.pp.x, 0, 1e3 * c.s, c.pp.y, 0, 0, 1),
+                                c.frame, {-0.1, 0, 0, 0, 0, 0.01, 0, 0});
+    writeReconstruction(in + "/rational.yml", persp);
+    EXPECT_TRUE(badInputRejected(exportArgs(d.frames, in + "/rational.yml", d.scene, script),
+                                 {"rational.yml", "frame 0", "coefficient 5"}, out_));
+}
+
 } // namespace
 } // namespace opencv_test

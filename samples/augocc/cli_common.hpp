@@ -120,6 +120,7 @@ void registerSfm(CLI::App& app, Globals& g);
 void registerClone(CLI::App& app, Globals& g);
 void registerMatte(CLI::App& app, Globals& g);
 void registerComposite(CLI::App& app, Globals& g);
+void registerExportBlender(CLI::App& app, Globals& g);
 void registerRun(CLI::App& app, Globals& g);
 void registerDemo(CLI::App& app, Globals& g);
 void registerAnnotate(CLI::App& app, Globals& g);

@@ -31,6 +31,7 @@ int main(int argc, char** argv)
     registerClone(app, g);
     registerMatte(app, g);
     registerComposite(app, g);
+    registerExportBlender(app, g);
     registerRun(app, g);
     registerDemo(app, g);
     registerAnnotate(app, g);

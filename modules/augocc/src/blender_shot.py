@@ -1,0 +1,318 @@
+# This file is part of augocc. License: Apache-2.0.
+# The body of the script `augocc export-blender` writes (after SHOT_JSON, this shot's data); it
+# is embedded in the library at build time (modules/augocc/CMakeLists.txt). Blender 3.4+.
+#
+# Conventions (the conversion is done by augocc, src/blender_export.cpp; this script applies it):
+# - Blender frame = augocc frame + 1 (Blender numbers clips and image sequences from 1).
+# - Everything is a child of the empty `augocc_world`, whose transform takes the reconstruction's
+#   world to Blender's z-up world (x right of the mean view, y away from the viewer, z up, the
+#   estimated ground at z = 0). Assets and camera keyframes are in the reconstruction's world.
+# - OpenCV's camera looks down +z with y down; Blender's looks down -z with y up. The camera's
+#   matrix (camera to world) therefore has the columns R^T * diag(1, -1, -1) and the camera centre
+#   (an orthographic camera is moved back along its axis, which does not change its image, so that
+#   nothing is behind it).
+# - Sensor fit HORIZONTAL: ortho_scale = W / s, lens = fx * sensor_width / W, shift_x =
+#   (W / 2 - cx - 0.5) / W, shift_y = (cy + 0.5 - H / 2) / W: OpenCV's pixel centres are at
+#   integer coordinates (origin at the centre of the top-left pixel), Blender's frame spans
+#   [0, W] x [0, H] with y up.
+
+import json
+import os
+
+import bpy
+import mathutils
+import numpy as np
+
+SHOT = json.loads(SHOT_JSON)
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def shot_path(p):
+    return p if os.path.isabs(p) else os.path.normpath(os.path.join(HERE, p))
+
+
+def blender_frame(f):
+    return f + 1
+
+
+def read_ply(filepath):
+    """The binary little-endian PLY augocc writes (writeMeshPly): vertices, faces, optional
+    normals and colours. Returns (xyz, faces, normals or None, rgb or None)."""
+    with open(filepath, 'rb') as f:
+        elements = []
+        line = f.readline().decode('ascii').strip()
+        if line != 'ply':
+            raise RuntimeError(filepath + ': not a PLY file')
+        while True:
+            line = f.readline().decode('ascii').strip()
+            if line == 'end_header':
+                break
+            words = line.split()
+            if words[0] == 'element':
+                elements.append((words[1], int(words[2]), []))
+            elif words[0] == 'property':
+                elements[-1][2].append(words)
+            elif words[0] == 'format' and words[1] != 'binary_little_endian':
+                raise RuntimeError(filepath + ': expected binary_little_endian')
+        data = f.read()
+    types = {'float': '<f4', 'uchar': 'u1', 'int': '<i4'}
+    xyz = np.zeros((0, 3), np.float32)
+    faces = np.zeros((0, 3), np.int32)
+    normals = rgb = None
+    offset = 0
+    for name, count, props in elements:
+        if name == 'vertex':
+            dt = np.dtype([(p[2], types[p[1]]) for p in props])
+            v = np.frombuffer(data, dt, count, offset)
+            offset += dt.itemsize * count
+            xyz = np.stack([v['x'], v['y'], v['z']], 1)
+            if 'nx' in dt.names:
+                normals = np.stack([v['nx'], v['ny'], v['nz']], 1)
+            if 'red' in dt.names:
+                rgb = np.stack([v['red'], v['green'], v['blue']], 1) / 255.0
+        elif name == 'face':
+            dt = np.dtype([('n', 'u1'), ('i', '<i4', 3)])
+            fc = np.frombuffer(data, dt, count, offset)
+            offset += dt.itemsize * count
+            if count and not np.all(fc['n'] == 3):
+                raise RuntimeError(filepath + ': faces must be triangles')
+            faces = fc['i']
+    return xyz, faces, normals, rgb
+
+
+def mesh_object(name, filepath, parent):
+    xyz, faces, normals, rgb = read_ply(shot_path(filepath))
+    me = bpy.data.meshes.new(name)
+    me.vertices.add(len(xyz))
+    me.vertices.foreach_set('co', xyz.astype(np.float32).ravel())
+    me.loops.add(3 * len(faces))
+    me.loops.foreach_set('vertex_index', faces.astype(np.int32).ravel())
+    me.polygons.add(len(faces))
+    me.polygons.foreach_set('loop_start', np.arange(0, 3 * len(faces), 3, dtype=np.int32))
+    me.polygons.foreach_set('loop_total', np.full(len(faces), 3, np.int32))
+    me.update()
+    me.validate()
+    if normals is not None and len(faces):
+        me.polygons.foreach_set('use_smooth', np.ones(len(faces), bool))
+        me.use_auto_smooth = True
+        me.normals_split_custom_set_from_vertices([tuple(n) for n in normals])
+    if rgb is not None:
+        attr = me.color_attributes.new('Col', 'FLOAT_COLOR', 'POINT')
+        rgba = np.concatenate([rgb, np.ones((len(rgb), 1))], 1).astype(np.float32)
+        attr.data.foreach_set('color', rgba.ravel())
+    ob = bpy.data.objects.new(name, me)
+    bpy.context.scene.collection.objects.link(ob)
+    ob.parent = parent
+    return ob
+
+
+def srgb_to_linear(c):
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+
+def setup_scene():
+    scene = bpy.context.scene
+    scene.render.engine = 'CYCLES'
+    scene.cycles.device = 'CPU'
+    scene.cycles.samples = SHOT['samples']
+    # Debian's Blender 3.4 is built without OpenImageDenoise, and Cycles then refuses to render
+    # with denoising on ("Build without OpenImageDenoiser"): off; turn it on where Blender has it.
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x = SHOT['width']
+    scene.render.resolution_y = SHOT['height']
+    scene.render.resolution_percentage = 100
+    scene.render.pixel_aspect_x = 1
+    scene.render.pixel_aspect_y = 1
+    fps = SHOT['fps']
+    scene.render.fps = max(1, round(fps))
+    scene.render.fps_base = scene.render.fps / fps
+    scene.frame_start = blender_frame(SHOT['first_frame'])
+    scene.frame_end = blender_frame(SHOT['end_frame'] - 1)
+    # Transparent film: the footage goes behind the render in the compositor; the alpha is the
+    # virtual objects where no clone (holdout) hides them, plus the shadow catcher's shadows.
+    scene.render.film_transparent = True
+    scene.view_settings.view_transform = 'Standard'
+    return scene
+
+
+def add_camera(scene, world):
+    data = bpy.data.cameras.new('augocc_camera')
+    data.type = SHOT['model']
+    data.sensor_fit = 'HORIZONTAL'
+    data.sensor_width = SHOT['sensor_width']
+    data.clip_start = SHOT['clip_start']
+    data.clip_end = SHOT['clip_end']
+    cam = bpy.data.objects.new('augocc_camera', data)
+    scene.collection.objects.link(cam)
+    cam.parent = world
+    cam.rotation_mode = 'QUATERNION'
+    scene.camera = cam
+    last = None
+    for c in SHOT['cameras']:
+        fr = blender_frame(c['frame'])
+        m = mathutils.Matrix([c['matrix'][4 * i:4 * i + 4] for i in range(4)])
+        loc, rot, _ = m.decompose()
+        if last is not None and last.dot(rot) < 0:
+            rot.negate()  # the same rotation, no flip in the interpolation
+        last = rot
+        cam.location = loc
+        cam.rotation_quaternion = rot
+        cam.keyframe_insert('location', frame=fr)
+        cam.keyframe_insert('rotation_quaternion', frame=fr)
+        if 'ortho_scale' in c:
+            data.ortho_scale = c['ortho_scale']
+            data.keyframe_insert('ortho_scale', frame=fr)
+        else:
+            data.lens = c['lens']
+            data.keyframe_insert('lens', frame=fr)
+        data.shift_x = c['shift_x']
+        data.shift_y = c['shift_y']
+        data.keyframe_insert('shift_x', frame=fr)
+        data.keyframe_insert('shift_y', frame=fr)
+    for ad in (cam.animation_data, data.animation_data):
+        for fc in ad.action.fcurves:
+            for k in fc.keyframe_points:
+                k.interpolation = 'LINEAR'
+    return cam
+
+
+def add_footage(scene, cam):
+    if not SHOT['footage']:
+        return None
+    clip = bpy.data.movieclips.load(shot_path(SHOT['footage']))
+    clip.frame_start = blender_frame(0)
+    scene.active_clip = clip
+    W, H = SHOT['width'], SHOT['height']
+    d = SHOT['distortion']
+    if d:
+        tc = clip.tracking.camera
+        tc.sensor_width = SHOT['sensor_width']
+        tc.units = 'PIXELS'
+        tc.pixel_aspect = 1
+        tc.focal_length_pixels = d['focal_px']
+        # Blender's clip pixels: origin at the bottom-left corner, y up.
+        principal = (d['cx'] + 0.5, H - (d['cy'] + 0.5))
+        if hasattr(tc, 'principal_point_pixels'):  # Blender 3.5+
+            tc.principal_point_pixels = principal
+        else:
+            tc.principal = principal
+        tc.distortion_model = d['model']
+        if d['model'] == 'POLYNOMIAL':
+            tc.k1, tc.k2, tc.k3 = d['k1'], d['k2'], d['k3']
+        else:
+            tc.brown_k1, tc.brown_k2, tc.brown_k3 = d['k1'], d['k2'], d['k3']
+            tc.brown_p1, tc.brown_p2 = d['p1'], d['p2']
+    cam.data.show_background_images = True
+    bg = cam.data.background_images.new()
+    bg.source = 'MOVIE_CLIP'
+    bg.clip = clip
+    bg.clip_user.use_render_undistorted = bool(d)
+    bg.alpha = 1.0
+    return clip
+
+
+def add_compositor(scene, clip):
+    """Footage behind the render; the render distorted by the clip's lens first."""
+    if clip is None:
+        return
+    scene.use_nodes = True
+    tree = scene.node_tree
+    tree.nodes.clear()
+    layers = tree.nodes.new('CompositorNodeRLayers')
+    footage = tree.nodes.new('CompositorNodeMovieClip')
+    footage.clip = clip
+    over = tree.nodes.new('CompositorNodeAlphaOver')
+    out = tree.nodes.new('CompositorNodeComposite')
+    render = layers.outputs['Image']
+    if SHOT['distortion']:
+        distort = tree.nodes.new('CompositorNodeMovieDistortion')
+        distort.clip = clip
+        distort.distortion_type = 'DISTORT'
+        tree.links.new(render, distort.inputs['Image'])
+        render = distort.outputs['Image']
+    tree.links.new(footage.outputs['Image'], over.inputs[1])
+    tree.links.new(render, over.inputs[2])
+    tree.links.new(over.outputs['Image'], out.inputs['Image'])
+
+
+def add_clones(scene, world):
+    """The real objects' clones as holdouts: the trimmed model always, each key frame's patch
+    voxels in the frames whose patch set holds it. They cast no shadow: the real objects'
+    shadows are in the footage already, and the shadow catcher would add them a second time
+    (Blender 3.4 has no light linking to keep only their shadows on the virtual objects)."""
+    frames = range(SHOT['first_frame'], SHOT['end_frame'])
+    for c in SHOT['clones']:
+        ob = mesh_object('clone_' + c['name'], c['file'], world)
+        ob.is_holdout = True
+        ob.visible_shadow = False
+        for p in c['patches']:
+            po = mesh_object('clone_%s_patches_%04d' % (c['name'], p['key_frame']), p['file'],
+                             world)
+            po.is_holdout = True
+            po.visible_shadow = False
+            shown = set(p['frames'])
+            previous = None
+            for f in frames:
+                hidden = f not in shown
+                if hidden != previous:
+                    po.hide_render = po.hide_viewport = hidden
+                    po.keyframe_insert('hide_render', frame=blender_frame(f))
+                    po.keyframe_insert('hide_viewport', frame=blender_frame(f))
+                    previous = hidden
+
+
+def add_objects(scene, world):
+    for o in SHOT['objects']:
+        ob = mesh_object(o['name'], o['file'], world)
+        mat = bpy.data.materials.new(o['name'])
+        mat.use_nodes = True
+        bsdf = mat.node_tree.nodes['Principled BSDF']
+        r, g, b = (srgb_to_linear(v) for v in o['color'])
+        bsdf.inputs['Base Color'].default_value = (r, g, b, 1)
+        bsdf.inputs['Roughness'].default_value = 0.8
+        if ob.data.color_attributes:
+            attr = mat.node_tree.nodes.new('ShaderNodeVertexColor')
+            attr.layer_name = ob.data.color_attributes[0].name
+            mat.node_tree.links.new(attr.outputs['Color'], bsdf.inputs['Base Color'])
+        ob.data.materials.append(mat)
+
+
+def add_ground_and_sun(scene, world):
+    me = bpy.data.meshes.new('augocc_ground')
+    me.from_pydata([tuple(v) for v in SHOT['ground']], [], [(0, 1, 2, 3)])
+    ground = bpy.data.objects.new('augocc_ground', me)
+    scene.collection.objects.link(ground)
+    ground.parent = world
+    ground.is_shadow_catcher = True
+    sun_data = bpy.data.lights.new('augocc_sun', 'SUN')
+    sun_data.energy = 3.0
+    sun = bpy.data.objects.new('augocc_sun', sun_data)
+    scene.collection.objects.link(sun)
+    sun.parent = world
+    # A sun shines along its -z: its +z points towards the light.
+    sun.rotation_mode = 'QUATERNION'
+    sun.rotation_quaternion = mathutils.Vector(SHOT['sun_direction']).to_track_quat('Z', 'Y')
+    world_data = bpy.data.worlds.new('augocc_world')
+    world_data.color = (0.3, 0.3, 0.3)  # ambient
+    scene.world = world_data
+
+
+def build_shot():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = setup_scene()
+    world = bpy.data.objects.new('augocc_world', None)
+    scene.collection.objects.link(world)
+    world.matrix_world = mathutils.Matrix(
+        [SHOT['world_matrix'][4 * i:4 * i + 4] for i in range(4)])
+    cam = add_camera(scene, world)
+    clip = add_footage(scene, cam)
+    add_compositor(scene, clip)
+    add_clones(scene, world)
+    add_objects(scene, world)
+    add_ground_and_sun(scene, world)
+    scene.frame_set(scene.frame_start)
+    if SHOT['blend']:
+        bpy.ops.wm.save_as_mainfile(filepath=shot_path(SHOT['blend']))
+
+
+build_shot()
