@@ -899,10 +899,7 @@ PYBIND11_MODULE(augocc, m)
         .def_readonly("fromPlane", &GroundFrame::fromPlane)
         .def_property_readonly("up", [](const GroundFrame& g) {
                                    return py::make_tuple(g.up[0], g.up[1], g.up[2]); })
-        .def("rotation", [](const GroundFrame& g) {
-                 return matxToNumpy<3, 3>(Matx33d(g.right[0], g.right[1], g.right[2], g.up[0],
-                                                  g.up[1], g.up[2], g.back[0], g.back[1],
-                                                  g.back[2])); },
+        .def("rotation", [](const GroundFrame& g) { return matxToNumpy<3, 3>(g.rotation()); },
              "Rows (right, up, back): the Compositor's lightRotation that compositeSequence() "
              "and `augocc composite` use (CompositeOptions::lightFromGround).");
     m.def("estimateGround", &estimateGround, py::arg("rec"));

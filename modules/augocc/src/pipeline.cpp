@@ -75,13 +75,6 @@ private:
     bool committed_ = false;
 };
 
-// Rows (right, up, back): world directions to the shading frame.
-Matx33d groundRotation(const GroundFrame& g)
-{
-    return Matx33d(g.right[0], g.right[1], g.right[2], g.up[0], g.up[1], g.up[2], g.back[0],
-                   g.back[1], g.back[2]);
-}
-
 // `name` in the temporary folder `tmp` of the output folder `shown` (errors name the latter).
 void writeImage(const String& tmp, const String& shown, const String& name, const Mat& img)
 {
@@ -179,7 +172,7 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
     cp.supersample = options.supersample;
     cp.antialiasVirtual = options.antialiasVirtual;
     if (options.lightFromGround)
-        cp.lightRotation = groundRotation(estimateGround(rec));
+        cp.lightRotation = estimateGround(rec).rotation();
     Ptr<Compositor> comp = Compositor::create(cp);
     comp->setVirtualObjects(virtualObjects);
     VideoWriter writer;
@@ -647,7 +640,7 @@ DemoResult runDemo(const DemoOptions& o)
                      M(2, 2));
     const double sigma = std::cbrt(cv::determinant(Ma));
     Compositor::Params soft, hard;
-    soft.lightRotation = groundRotation(estimateGround(rec));
+    soft.lightRotation = estimateGround(rec).rotation();
     hard.supersample = 1;
     // The truth is lit in the true world (y up) by the synthesizer: light it the same way here.
     Ptr<Compositor> ours = Compositor::create(soft), ref = Compositor::create(hard);

@@ -337,6 +337,11 @@ Vec3d GroundFrame::fromGround(const Vec3d& g) const
     return right * g[0] + up * (g[1] + height) + back * g[2];
 }
 
+Matx33d GroundFrame::rotation() const
+{
+    return Matx33d(right[0], right[1], right[2], up[0], up[1], up[2], back[0], back[1], back[2]);
+}
+
 GroundFrame estimateGround(const Reconstruction& rec)
 {
     if (rec.cameras.empty())

@@ -103,6 +103,9 @@ struct CV_EXPORTS GroundFrame
     Vec3d toGround(const Vec3d& Xw) const;
     //! Ground coordinates to a world point.
     Vec3d fromGround(const Vec3d& g) const;
+    //! Rows (right, up, back): world directions to ground axes; the Compositor's lightRotation
+    //! of `composite` (CompositeOptions::lightFromGround).
+    Matx33d rotation() const;
 };
 
 //! @brief Estimates the ground frame of a reconstruction (see GroundFrame).
