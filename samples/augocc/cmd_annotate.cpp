@@ -514,19 +514,7 @@ private:
         const std::string path =
             (fs::path(dir) / format("annotate_%s_%04d_%d.png", objectName().c_str(), frame_,
                                     shots_++)).string();
-        writeAtomically(path, [&](const String& tmp) {
-            // The temporary name keeps no image extension: encode explicitly.
-            std::vector<uchar> buf;
-            imencode(".png", canvas_, buf);
-            FILE* f = std::fopen(tmp.c_str(), "wb");
-            if (!f || std::fwrite(buf.data(), 1, buf.size(), f) != buf.size())
-            {
-                if (f)
-                    std::fclose(f);
-                CV_Error(Error::StsError, "cannot write " + path);
-            }
-            std::fclose(f);
-        });
+        writeImageAtomically(path, canvas_);  // every write checked (a full disk)
         status_ = "screenshot " + path;
         info(g_, "annotate: " + status_);
     }

@@ -188,10 +188,7 @@ void runSynth(const Globals& g, const SynthOptions& o)
         if (ec)
             throw UsageError("--contact-sheet " + o.contactSheet + ": cannot create its folder: " +
                              ec.message());
-        writeAtomically(o.contactSheet, [&](const String& tmp) {
-            if (!imwrite(tmp, sheet))
-                CV_Error(Error::StsError, o.contactSheet + ": cannot write");
-        });
+        writeImageAtomically(o.contactSheet, sheet);  // every write checked (a full disk)
         info(g, "contact sheet: " + o.contactSheet);
     }
     info(g, "wrote " + o.out);

@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <sys/stat.h>
 #include <opencv2/augocc.hpp>
 
 namespace fs = std::filesystem;
@@ -372,15 +371,7 @@ void writePlan(const Plan& plan, const Options& o)
 
 void writeTextFile(const std::string& path, const std::string& text, bool executable)
 {
-    cv::augocc::writeAtomically(path, [&](const cv::String& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.close();
-        if (!out)
-            CV_Error(cv::Error::StsError, path + ": cannot be written");
-        if (executable && chmod(tmp.c_str(), 0755) != 0)
-            CV_Error(cv::Error::StsError, path + ": cannot be made executable");
-    });
+    cv::augocc::writeFileAtomically(path, text, executable);  // every write checked
 }
 
 void readPlan(const std::string& outDir, Plan& plan, Options& o)

@@ -11,6 +11,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
@@ -419,6 +420,21 @@ void writeAtomically(const String& path, const std::function<void(const String& 
         removeTmp();
         throw;
     }
+}
+
+void writeFileAtomically(const String& path, const String& bytes, bool executable)
+{
+    writeAtomically(path, [&](const String& tmp) {
+        detail::writeFileBytes(tmp, bytes.data(), bytes.size(), path);
+        if (executable && ::chmod(tmp.c_str(), 0755) != 0)
+            failWithErrno(path, "cannot be made executable", errno);
+    });
+}
+
+void writeImageAtomically(const String& path, InputArray image)
+{
+    // The temporary keeps the extension (tmpNameFor), which picks the format.
+    writeAtomically(path, [&](const String& tmp) { detail::writeImageFile(tmp, image, path); });
 }
 
 } // namespace augocc

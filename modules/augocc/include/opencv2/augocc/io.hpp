@@ -277,6 +277,20 @@ calls). Used by every writer of the module (and the CLI). */
 CV_EXPORTS void writeAtomically(const String& path,
                                 const std::function<void(const String& tmpPath)>& writer);
 
+/** @brief Writes `bytes` to `path` all or nothing (writeAtomically()), every write(), fsync() and
+close() checked: a full disk is StsError naming `path` and "No space left on device".
+@param path the file.
+@param bytes its whole content.
+@param executable also make the file executable (mode 0755 before the rename: scripts).
+*/
+CV_EXPORTS void writeFileAtomically(const String& path, const String& bytes,
+                                    bool executable = false);
+
+/** @brief Encodes `image` in the format `path`'s extension names (as imwrite) and writes it all or
+nothing, every write checked (imwrite itself does not report a full disk). StsError naming `path`
+when the image cannot be encoded or written. */
+CV_EXPORTS void writeImageAtomically(const String& path, InputArray image);
+
 //! @}
 
 } // namespace augocc
