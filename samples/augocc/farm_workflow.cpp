@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>
 #include <opencv2/augocc.hpp>
 
 namespace fs = std::filesystem;
@@ -348,9 +349,41 @@ std::vector<std::string> sbatchArgs(const Submission& s, const std::string& depe
     return a;
 }
 
-void writePlan(const Plan& plan, const Options& o)
+namespace {
+
+// `name` of farm/ written completely into `staging` (errors name its place in farmDir).
+void writeStaged(const fs::path& staging, const fs::path& farmDir, const std::string& name,
+                 const std::string& text, bool executable)
 {
-    const std::string path = (fs::path(plan.shot.outDir) / "farm" / "plan.yml").string();
+    const std::string shown = (farmDir / name).string();
+    try
+    {
+        cv::augocc::writeFileAtomically((staging / name).string(), text, executable);
+    }
+    catch (const cv::Exception& e)
+    {
+        // The staging folder is an implementation detail: name the file the user will see.
+        std::string msg = e.err;
+        const std::string tmp = (staging / name).string();
+        for (size_t at; (at = msg.find(tmp)) != std::string::npos;)
+            msg.replace(at, tmp.size(), shown);
+        CV_Error(cv::Error::StsError, msg);
+    }
+}
+
+void commitStaged(const fs::path& staging, const fs::path& farmDir, const std::string& name)
+{
+    std::error_code ec;
+    fs::rename(staging / name, farmDir / name, ec);
+    if (ec)
+        CV_Error(cv::Error::StsError,
+                 (farmDir / name).string() + ": cannot be written: " + ec.message());
+}
+
+} // namespace
+
+std::string planText(const Plan& plan, const Options& o)
+{
     cv::FileStorage fsw(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     fsw << "description" << "augocc farm: the shot's workflow (augocc farm resume reads it)";
     fsw << "name" << plan.shot.name << "input" << plan.shot.input << "masks" << plan.shot.masks
@@ -366,12 +399,51 @@ void writePlan(const Plan& plan, const Options& o)
     for (const std::string& l : o.setup)
         fsw << l;
     fsw << "]";
-    writeTextFile(path, fsw.releaseAndGetString());
+    return fsw.releaseAndGetString();
 }
 
-void writeTextFile(const std::string& path, const std::string& text, bool executable)
+void writePlan(const Plan& plan, const Options& o)
 {
-    cv::augocc::writeFileAtomically(path, text, executable);  // every write checked
+    writeWorkflow(plan, {}, o);
+}
+
+void writeWorkflow(const Plan& plan, const std::vector<Script>& scripts, const Options& o)
+{
+    const fs::path outDir(plan.shot.outDir), farmDir = outDir / "farm";
+    // Folders made here go again on failure: the outermost one that did not exist.
+    fs::path made;
+    for (fs::path d = farmDir / "logs"; !d.empty() && !fs::exists(d); d = d.parent_path())
+        made = d;
+    // Every file is written into a staging folder first; only when all are complete are they
+    // renamed into farm/ (renames need no space): a full disk leaves the workflow as it was.
+    const fs::path staging = outDir / cv::format(".farm.tmp%d", (int)getpid());
+    std::error_code ec;
+    try
+    {
+        fs::create_directories(farmDir / "logs", ec);
+        if (ec)
+            CV_Error(cv::Error::StsError,
+                     (farmDir / "logs").string() + ": cannot create folder: " + ec.message());
+        fs::remove_all(staging, ec);
+        fs::create_directory(staging, ec);
+        if (ec)
+            CV_Error(cv::Error::StsError,
+                     farmDir.string() + ": cannot create its staging folder: " + ec.message());
+        for (const Script& s : scripts)
+            writeStaged(staging, farmDir, s.file, s.text, true);
+        writeStaged(staging, farmDir, "plan.yml", planText(plan, o), false);
+        for (const Script& s : scripts)
+            commitStaged(staging, farmDir, s.file);
+        commitStaged(staging, farmDir, "plan.yml");
+        fs::remove_all(staging, ec);
+    }
+    catch (...)
+    {
+        fs::remove_all(staging, ec);
+        if (!made.empty())
+            fs::remove_all(made, ec);
+        throw;
+    }
 }
 
 void readPlan(const std::string& outDir, Plan& plan, Options& o)
