@@ -170,6 +170,37 @@ TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
     fs::remove_all(dir);
 }
 
+TEST(Augocc_InputLimits, regression_fuzz_xml_cut_short)
+{
+    // Found by fuzz_tracks: a file ending inside XML markup ("<?xml version=", the whole finding)
+    // made OpenCV 4.6's XML parser read past the text's end (SEGV in FileStorage::open).
+    const std::string f = dataFile("fuzz_tracks_xml_cut_segv.yml");
+    for (const auto& read : storageReaders(f))
+        EXPECT_TRUE(throwsWith(read, {f, "line 1", "processing instruction not closed"}));
+    // Each construct cut short, every reader: a clear error naming the line, no parse attempt.
+    const std::string dir = tempDir("limits_xml");
+    const std::pair<const char*, const char*> cuts[] = {
+        {"<?xml version=\"1.0\"?>\n<opencv_storage>\n<!-- a comment", "comment not closed"},
+        {"<?xml version=\"1.0\"?>\n<opencv_storage>\n<frames type_id=\"opencv", "quoted value"},
+        {"<?xml version=\"1.0\"?>\n<opencv_storage>\n<frames", "markup not closed"}};
+    for (const auto& c : cuts)
+    {
+        const std::string p = dir + "/cut.xml";
+        writeText(p, c.first);
+        for (const auto& read : storageReaders(p))
+            EXPECT_TRUE(throwsWith(read, {p, "line 3", c.second}));
+    }
+    // A complete XML file still reads (calibrateCamera users write XML calibration files).
+    const std::string ok = dir + "/calibration.xml";
+    writeText(ok, "<?xml version=\"1.0\"?>\n<opencv_storage>\n<camera_matrix type_id=\"opencv-matrix\">"
+                  "<rows>3</rows><cols>3</cols><dt>d</dt><data>500. 0. 320. 0. 500. 240. 0. 0. "
+                  "1.</data></camera_matrix>\n<distortion_coefficients type_id=\"opencv-matrix\">"
+                  "<rows>1</rows><cols>5</cols><dt>d</dt><data>0. 0. 0. 0. 0.</data>"
+                  "</distortion_coefficients>\n</opencv_storage>\n");
+    EXPECT_NO_THROW(readCalibration(ok));
+    fs::remove_all(dir);
+}
+
 TEST(Augocc_InputLimits, regression_duplicate_keys)
 {
     // FileStorage silently kept the first of two 'frames' keys.

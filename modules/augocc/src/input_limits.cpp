@@ -4,6 +4,7 @@
 #include "precomp.hpp"
 #include "input_limits.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <strings.h>
 #include <filesystem>
@@ -421,6 +422,57 @@ void checkYamlTopLevel(const std::string& text, const String& path, const String
     }
 }
 
+// OpenCV 4.6's XML parser reads past the end of the text when the file ends inside markup
+// ("<?xml version=": SEGV, found by fuzz_tracks). Every comment, processing instruction,
+// declaration and tag must be closed, quoted attribute values included, before the end.
+void checkXmlMarkup(const std::string& text, const String& path, const String& what)
+{
+    const size_t n = text.size();
+    auto lineOf = [&](size_t at) {
+        return 1 + (int)std::count(text.begin(), text.begin() + (std::ptrdiff_t)at, '\n');
+    };
+    auto fail = [&](size_t at, const char* problem) {
+        CV_Error(Error::StsParseError, path + cv::format(": %s: line %d ('%s'): %s before the "
+                 "end of the file (cut short?)", what.c_str(), lineOf(at),
+                 text.substr(at, 40).c_str(), problem));
+    };
+    for (size_t i = text.find('<'); i != std::string::npos; i = text.find('<', i))
+    {
+        const size_t start = i;
+        if (!text.compare(i, 4, "<!--"))
+        {
+            const size_t end = text.find("-->", i + 4);
+            if (end == std::string::npos)
+                fail(start, "a comment not closed by '-->'");
+            i = end + 3;
+            continue;
+        }
+        if (!text.compare(i, 2, "<?"))
+        {
+            const size_t end = text.find("?>", i + 2);
+            if (end == std::string::npos)
+                fail(start, "a processing instruction not closed by '?>'");
+        }
+        // To the markup's '>', past quoted values.
+        char quote = 0;
+        for (i++; i < n; i++)
+        {
+            if (quote)
+            {
+                if (text[i] == quote)
+                    quote = 0;
+            }
+            else if (text[i] == '"' || text[i] == '\'')
+                quote = text[i];
+            else if (text[i] == '>')
+                break;
+        }
+        if (i >= n)
+            fail(start, quote ? "a quoted value not closed" : "markup not closed by '>'");
+        i++;
+    }
+}
+
 } // namespace
 
 int storageNestingDepth(const char* data, size_t size, int stopAt)
@@ -467,6 +519,9 @@ void checkStorageFile(const String& path, const String& what)
                  "(binary data, not a YAML, JSON or XML text)", what.c_str(),
                  (size_t)((const char*)std::memchr(text.data(), 0, text.size()) - text.data())));
     checkYamlTopLevel(text, path, what);
+    const size_t first = text.find_first_not_of(" \t\r\n");
+    if (first != std::string::npos && text[first] == '<')
+        checkXmlMarkup(text, path, what);
     const int depth = storageNestingDepth(text.data(), text.size(), kMaxStorageDepth);
     if (depth > kMaxStorageDepth)
         CV_Error(Error::StsOutOfRange, path + cv::format(": %s nests deeper than augocc's limit "
