@@ -278,6 +278,28 @@ int jsonDepth(const char* s, size_t n, int stopAt)
     return maxDepth;
 }
 
+// The '>' that ends the markup whose text starts at `i`, past quoted values; `n` when the text
+// ends first (then *openQuote, when given, is the quote still open, or 0).
+size_t xmlMarkupEnd(const char* s, size_t n, size_t i, char* openQuote)
+{
+    char quote = 0;
+    for (; i < n; i++)
+    {
+        if (quote)
+        {
+            if (s[i] == quote)
+                quote = 0;
+        }
+        else if (s[i] == '"' || s[i] == '\'')
+            quote = s[i];
+        else if (s[i] == '>')
+            return i;
+    }
+    if (openQuote)
+        *openQuote = quote;
+    return n;
+}
+
 // XML: elements nest by tags; comments, processing instructions and declarations do not.
 int xmlDepth(const char* s, size_t n, int stopAt)
 {
@@ -313,25 +335,9 @@ int xmlDepth(const char* s, size_t n, int stopAt)
             if (maxDepth > stopAt)
                 return maxDepth;
             // To the tag's end, past quoted attribute values; "/>" closes it at once.
-            i++;
-            char quote = 0;
-            while (i < n)
-            {
-                if (quote)
-                {
-                    if (s[i] == quote)
-                        quote = 0;
-                }
-                else if (s[i] == '"' || s[i] == '\'')
-                    quote = s[i];
-                else if (s[i] == '>')
-                {
-                    if (s[i - 1] == '/')
-                        depth--;
-                    break;
-                }
-                i++;
-            }
+            i = xmlMarkupEnd(s, n, i + 1, nullptr);
+            if (i < n && s[i - 1] == '/')
+                depth--;
             i++;
         }
     }
@@ -453,20 +459,8 @@ void checkXmlMarkup(const std::string& text, const String& path, const String& w
             if (end == std::string::npos)
                 fail(start, "a processing instruction not closed by '?>'");
         }
-        // To the markup's '>', past quoted values.
         char quote = 0;
-        for (i++; i < n; i++)
-        {
-            if (quote)
-            {
-                if (text[i] == quote)
-                    quote = 0;
-            }
-            else if (text[i] == '"' || text[i] == '\'')
-                quote = text[i];
-            else if (text[i] == '>')
-                break;
-        }
+        i = xmlMarkupEnd(text.data(), n, i + 1, &quote);
         if (i >= n)
             fail(start, quote ? "a quoted value not closed" : "markup not closed by '>'");
         i++;
