@@ -163,6 +163,15 @@ TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
     const std::string marker = dataFile("fuzz_scene_marker_hang.yml");
     EXPECT_TRUE(throwsWith([&] { readScene(marker); },
                            {marker, "line 2", "'---' document marker"}));
+    // Found by fuzz_calibration: a "..." document end with text glued to it, or followed by a
+    // line starting with '-', made FileStorage::open loop for ever (the finding, and its cores).
+    const std::string end = dataFile("fuzz_calibration_document_end_hang.yml");
+    EXPECT_TRUE(throwsWith([&] { readCalibration(end); },
+                           {end, "line 5", "'...' document marker"}));
+    const std::string afterEnd = dir + "/after_end.yml";
+    writeText(afterEnd, "%YAML:1.0\n---\na: 6\n...\n-x\n");
+    for (const auto& read : storageReaders(afterEnd))
+        EXPECT_TRUE(throwsWith(read, {afterEnd, "line 5", "top-level key"}));
     const std::string core = dir + "/core.yml";
     writeText(core, "%YAML:1.0\n  - name: x\n-x--\n");
     for (const auto& read : storageReaders(core))

@@ -396,6 +396,10 @@ void checkYamlTopLevel(const std::string& text, const String& path, const String
         return;  // JSON or XML
     size_t start = 0;
     int line = 0;
+    // The first content line of every document (the file's start, after '---' or '...') must
+    // start a key: after a "..." document end, a line starting with '-' hung the parser too
+    // (fuzz_calibration).
+    bool expectKey = true;
     while (start < text.size())
     {
         size_t end = text.find('\n', start);
@@ -409,22 +413,23 @@ void checkYamlTopLevel(const std::string& text, const String& path, const String
         const size_t first = l.find_first_not_of(" \t");
         if (first == std::string::npos || l[0] == '%' || l[first] == '#')
             continue;
-        if (l.compare(0, 3, "---") == 0)
+        if (l.compare(0, 3, "---") == 0 || l.compare(0, 3, "...") == 0)
         {
-            // A document marker with text glued to it ("---Y:1") hung the parser as well when
-            // a sequence followed (fuzz_scene).
+            // A document marker with text glued to it ("---Y:1", "...-x") hung the parser as
+            // well when a sequence followed (fuzz_scene, fuzz_calibration).
             const size_t rest = l.find_first_not_of(" \t", 3);
             if (rest != std::string::npos && (l[rest] != '#' || rest == 3))
                 CV_Error(Error::StsParseError, path + cv::format(": %s: line %d ('%s'): text "
-                         "after the '---' document marker", what.c_str(), line,
-                         l.substr(0, 40).c_str()));
+                         "after the '%s' document marker", what.c_str(), line,
+                         l.substr(0, 40).c_str(), l.substr(0, 3).c_str()));
+            expectKey = true;
             continue;
         }
-        if (first != 0 || l[0] == '-')
+        if (expectKey && (first != 0 || l[0] == '-'))
             CV_Error(Error::StsParseError, path + cv::format(": %s: line %d ('%s') must start "
                      "a top-level key at the start of the line (the file's top level is a map)",
                      what.c_str(), line, l.substr(0, 40).c_str()));
-        return;
+        expectKey = false;
     }
 }
 
