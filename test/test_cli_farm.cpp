@@ -34,6 +34,21 @@ TEST(Augocc_Farm, split_frames)
     EXPECT_EQ(chunkDir({12, 16}), "chunks/0012-0016");
 }
 
+// readShotsFile's message for a shots file `file` holding `text` ("no error" when it reads).
+std::string shotsError(const fs::path& file, const std::string& text)
+{
+    std::ofstream(file) << text;
+    try
+    {
+        readShotsFile(file.string());
+    }
+    catch (const UsageError& e)
+    {
+        return std::string(e.what());
+    }
+    return std::string("no error");
+}
+
 TEST(Augocc_Farm, shots_file)
 {
     const fs::path dir = tempDir("farm_shots");
@@ -61,18 +76,7 @@ TEST(Augocc_Farm, shots_file)
     EXPECT_EQ(s[1].scene, "");
     EXPECT_EQ(s[1].name, "shot.b");
 
-    auto errorOf = [&](const std::string& text) {
-        std::ofstream(file) << text;
-        try
-        {
-            readShotsFile(file.string());
-        }
-        catch (const UsageError& e)
-        {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
+    auto errorOf = [&](const std::string& text) { return shotsError(file, text); };
     const std::string where = file.string() + ":2: ";
     EXPECT_EQ(errorOf("# nothing\n"), "--shots " + file.string() +
               ": no shot (a line 'input masks scene out-dir')");
@@ -105,18 +109,7 @@ TEST(Augocc_Farm, shots_file_yaml)
                            "\"out_dir\": \"o/x\" } ] }\n";
     ASSERT_EQ(readShotsFile(json.string()).size(), 1u);
 
-    auto errorOf = [&](const std::string& text) {
-        std::ofstream(file) << text;
-        try
-        {
-            readShotsFile(file.string());
-        }
-        catch (const UsageError& e)
-        {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
+    auto errorOf = [&](const std::string& text) { return shotsError(file, text); };
     const std::string f = file.string();
     EXPECT_EQ(errorOf("%YAML:1.0\n---\nshots: []\n").rfind("--shots " + f + ": no shot", 0), 0u);
     EXPECT_EQ(errorOf("%YAML:1.0\n---\nshots:\n  - { input: v, out_dir: o/x }\n"),
