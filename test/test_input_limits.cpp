@@ -168,6 +168,10 @@ TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
     const std::string end = dataFile("fuzz_calibration_document_end_hang.yml");
     EXPECT_TRUE(throwsWith([&] { readCalibration(end); },
                            {end, "line 5", "'...' document marker"}));
+    // The same in a clones file (fuzz_clones, the million-execution campaign: "...-bjects:").
+    const std::string clonesEnd = dataFile("fuzz_clones_document_end_hang.yml");
+    EXPECT_TRUE(throwsWith([&] { CloneSet::load(clonesEnd); },
+                           {clonesEnd, "line 6", "'...' document marker"}));
     const std::string afterEnd = dir + "/after_end.yml";
     writeText(afterEnd, "%YAML:1.0\n---\na: 6\n...\n-x\n");
     for (const auto& read : storageReaders(afterEnd))
