@@ -300,7 +300,7 @@ private:
         case 'a':
             add();
             break;
-        case 'x': case 65535:
+        case 'x': case 127: case 65535:
             if (requireSelection())
                 editor_->removeObject(sel);
             break;

@@ -33,7 +33,7 @@ struct Item
     MeshList meshes;     // object coordinates
     MeshList placed;     // world coordinates (scenePoses() applied)
     Matx44d pose;
-    Vec3d gmin, gmax;    // ground-aligned bounds of the placed vertices
+    Vec3d gmin, gmax;    // ground-aligned bounds of the placed vertices (in double)
 };
 
 struct State
@@ -360,6 +360,9 @@ public:
         const Vec3d c = basePoint(it);
         const Matx33d Ru = rotationFromRodrigues(ground_.up * (degrees * CV_PI / 180.0));
         setAbsolute(it, affine(Ru * linearPart(it.pose), c + Ru * (translationPart(it.pose) - c)));
+        // The footprint's box turns with the object: its centre moves unless the object is
+        // symmetric about that axis. Put the base point back where it was.
+        moveBase(it, c);
         return true;
     }
 
@@ -634,13 +637,17 @@ private:
         auto placed = std::make_shared<std::vector<Mesh>>();
         it.gmin = Vec3d::all(DBL_MAX);
         it.gmax = Vec3d::all(-DBL_MAX);
+        const Matx33d A = linearPart(it.pose);
+        const Vec3d t = translationPart(it.pose);
         for (const Mesh& m : *it.meshes)
         {
             Mesh w = m;
             w.transform(it.pose);
-            for (const Vec3f& v : w.vertices)
+            // Bounds in double from the object's vertices (not the placed floats): the base
+            // point then moves exactly with the pose, whatever path a drag took.
+            for (const Vec3f& v : m.vertices)
             {
-                const Vec3d g = ground_.toGround(Vec3d(v));
+                const Vec3d g = ground_.toGround(A * Vec3d(v) + t);
                 for (int k = 0; k < 3; k++)
                 {
                     it.gmin[k] = std::min(it.gmin[k], g[k]);

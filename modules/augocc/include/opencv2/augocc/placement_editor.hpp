@@ -154,7 +154,9 @@ public:
     /** @brief Moves the selected object's base point horizontally to above the ground point under
     px (undoable). @return false when nothing is selected or the ray misses the ground. */
     virtual bool moveTo(Point2d px) = 0;
-    /** @brief Turns the selected object about the vertical through its base point.
+    /** @brief Turns the selected object about the vertical through its base point (then puts
+    the base point back where it was: the footprint's box centre moves when the object is not
+    symmetric about that axis).
     @param degrees counter-clockwise seen from above (about GroundFrame::up).
     @return false when nothing is selected. */
     virtual bool rotate(double degrees) = 0;
