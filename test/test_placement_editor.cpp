@@ -183,9 +183,13 @@ TEST(Augocc_PlacementEditor, accuracy_edits_and_snap)
         for (int c = 0; c < 3; c++)
             EXPECT_NEAR(Q(r, c), A(r, c), 1e-9);
     ed->redo();
-    // Nearest clone: the dome at x = -3, z = 6 is nearest the building (front, at the origin).
+    // Nearest clone: the crate stands beside the building, so the building is the nearest.
     ed->selectObject(0);
-    EXPECT_FALSE(ed->snapToNearestClone(PlacementEditor::SNAP_RIGHT, 0).empty());
+    EXPECT_EQ("building", ed->snapToNearestClone(PlacementEditor::SNAP_RIGHT, 0));
+    EXPECT_EQ(SceneObject::PLACE_BESIDE, ed->getObject(0).placement);
+    EXPECT_EQ(1, ed->getObject(0).side);
+    ed->getObjectBounds(0, olo, ohi);
+    EXPECT_NEAR(chi[0], olo[0], kSnapTol);  // against the clone's right face, no gap
     // Undo all: back to the scene as given, not modified.
     while (ed->undo())
         ;
@@ -242,6 +246,28 @@ TEST(Augocc_PlacementEditor, regression_saved_scene_composites_to_preview)
     // ...and the preview did change the frame (a test that can fail).
     EXPECT_GT(norm(preview, shot.scene.frames[frame], NORM_L1), 1000.0);
     fs::remove_all(dir);
+}
+
+// The preview and the poses do not depend on the thread count (the Compositor's CPU stages and
+// the editor's bounds).
+TEST(Augocc_PlacementEditor, multithread_reproducibility)
+{
+    const PlacementShot& shot = placementShot();
+    Mat previews[2];
+    Vec3d bases[2];
+    for (int run = 0; run < 2; run++)
+    {
+        cv::setNumThreads(run == 0 ? 1 : 2);
+        Ptr<PlacementEditor> ed = makeEditor(shot);
+        ed->setFrame(1, shot.scene.frames[1]);
+        const Camera& cam = shot.scene.groundTruth.camera(1);
+        ASSERT_TRUE(scriptedDrag(*ed, 0, Point(cam.project(Vec3d(-1, 0, 5))), 3));
+        ed->rotate(20);
+        ed->render(previews[run]);
+        bases[run] = ed->getBasePoint(0);
+    }
+    EXPECT_EQ(0, norm(previews[0], previews[1], NORM_INF));
+    EXPECT_EQ(bases[0], bases[1]);
 }
 
 TEST(Augocc_PlacementEditor, bad_arg)
