@@ -3,6 +3,7 @@
 
 #include "test_precomp.hpp"
 
+#include <filesystem>
 #include <fstream>
 
 namespace opencv_test {
@@ -26,9 +27,11 @@ TEST(Augocc_Scene, read_write_roundtrip)
         "  - { name: quad, mesh: \"" + data + "quad.obj\", position: [1, 2, 3],"
         " rotation: [0, 90, 0], scale: 2 }\n"
         "  - { shape: tree, behind: building, distance: 0.5, size: 0.3,"
-        " material: { diffuse: [0.1, 0.9, 0.1] } }\n");
+        " material: { diffuse: [0.1, 0.9, 0.1] } }\n"
+        "  - { name: textured, mesh: \"" + data + "quad.obj\", position: [0, 0, 0],"
+        " material: { ambient: [0.2, 0.3, 0.4], texture: \"" + data + "quad_tex.png\" } }\n");
     const VirtualScene s = readScene(path);
-    ASSERT_EQ(s.objects.size(), 2u);
+    ASSERT_EQ(s.objects.size(), 3u);
     EXPECT_EQ(s.objects[0].name, "quad");
     EXPECT_EQ(s.objects[0].placement, SceneObject::PLACE_ABSOLUTE);
     EXPECT_EQ(s.objects[0].position, Vec3d(1, 2, 3));
@@ -38,6 +41,8 @@ TEST(Augocc_Scene, read_write_roundtrip)
     EXPECT_EQ(s.objects[1].meshes.size(), 2u);  // trunk and foliage
     EXPECT_EQ(s.objects[1].meshes[0].material.diffuse, Vec3f(0.1f, 0.9f, 0.1f));
     // Absolute placement: T * R * S; the quad's (1, 0, 0) corner -> R_y(90) * 2 -> (0, 0, -2).
+    EXPECT_EQ(s.objects[2].meshes[0].material.ambient, Vec3f(0.2f, 0.3f, 0.4f));
+    EXPECT_FALSE(s.objects[2].meshes[0].material.texture.empty());
     VirtualScene first = s;
     first.objects.resize(1);
     const std::vector<Matx44d> poses = scenePoses(first, Reconstruction(), nullptr);
@@ -51,10 +56,23 @@ TEST(Augocc_Scene, read_write_roundtrip)
     const std::string out = dir + "/again.yml";
     writeScene(out, s);
     const VirtualScene s2 = readScene(out);
-    ASSERT_EQ(s2.objects.size(), 2u);
+    ASSERT_EQ(s2.objects.size(), 3u);
     EXPECT_EQ(s2.objects[0].position, Vec3d(1, 2, 3));
     EXPECT_EQ(s2.objects[1].distance, 0.5);
     EXPECT_EQ(s2.objects[1].shape, "tree");
+    // The material overrides survive the round trip (a float written by FileStorage reads back
+    // exactly), for every mesh of the object, and a mesh without overrides gets none.
+    EXPECT_TRUE(s2.objects[0].material.empty());
+    for (const Mesh& m : s2.objects[1].meshes)
+        EXPECT_EQ(m.material.diffuse, Vec3f(0.1f, 0.9f, 0.1f));
+    EXPECT_TRUE(s2.objects[1].material.hasDiffuse);
+    EXPECT_FALSE(s2.objects[1].material.hasAmbient);
+    EXPECT_EQ(s2.objects[2].meshes[0].material.ambient, Vec3f(0.2f, 0.3f, 0.4f));
+    EXPECT_TRUE(std::filesystem::equivalent(s2.objects[2].material.texture,
+                                            s.objects[2].material.texture));
+    ASSERT_FALSE(s2.objects[2].meshes[0].material.texture.empty());
+    EXPECT_EQ(cv::norm(s2.objects[2].meshes[0].material.texture,
+                           s.objects[2].meshes[0].material.texture, NORM_INF), 0);
 }
 
 TEST(Augocc_Scene, bad_arg)

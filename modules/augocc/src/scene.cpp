@@ -240,38 +240,57 @@ VirtualScene readScene(const String& path)
         {
             const FileNode m = o["material"];
             checkKeys(m, kMaterialKeys, 3, path, where + ".material");
+            SceneObject::MaterialOverride& mo = so.material;
+            if ((mo.hasDiffuse = !m["diffuse"].empty()))
+                mo.diffuse = readColor(m["diffuse"], path, where + ".material.diffuse");
+            if ((mo.hasAmbient = !m["ambient"].empty()))
+                mo.ambient = readColor(m["ambient"], path, where + ".material.ambient");
+            Mat tex;
+            if (!m["texture"].empty())
+            {
+                const String rel = readString(m["texture"], path, where + ".material.texture");
+                mo.texture = fs::path(rel).is_absolute() ? rel : (dir / rel).string();
+                if (!fs::is_regular_file(mo.texture))
+                    sceneError(path, where + ".material.texture",
+                               mo.texture + ": cannot read image");
+                try
+                {
+                    tex = detail::readImageChecked(mo.texture, IMREAD_COLOR);
+                }
+                catch (const cv::Exception& e)
+                {
+                    sceneError(path, where + ".material.texture", e.err);
+                }
+            }
             for (Mesh& mesh : so.meshes)
             {
-                if (!m["diffuse"].empty())
+                if (mo.hasDiffuse)
                 {
-                    mesh.material.diffuse = readColor(m["diffuse"], path, where + ".material.diffuse");
+                    mesh.material.diffuse = mo.diffuse;
                     mesh.colors.clear();
                 }
-                if (!m["ambient"].empty())
-                    mesh.material.ambient = readColor(m["ambient"], path, where + ".material.ambient");
-                if (!m["texture"].empty())
-                {
-                    const String rel = readString(m["texture"], path, where + ".material.texture");
-                    const String file = fs::path(rel).is_absolute() ? rel : (dir / rel).string();
-                    if (!fs::is_regular_file(file))
-                        sceneError(path, where + ".material.texture", file + ": cannot read image");
-                    Mat tex;
-                    try
-                    {
-                        tex = detail::readImageChecked(file, IMREAD_COLOR);
-                    }
-                    catch (const cv::Exception& e)
-                    {
-                        sceneError(path, where + ".material.texture", e.err);
-                    }
+                if (mo.hasAmbient)
+                    mesh.material.ambient = mo.ambient;
+                if (!tex.empty())
                     mesh.material.texture = tex;
-                }
             }
         }
         scene.objects.push_back(std::move(so));
     }
     return scene;
 }
+
+namespace {
+
+//! A file named relative to a scene file's folder when it can be (else as it is).
+String relativeTo(const String& file, const fs::path& dir)
+{
+    std::error_code ec;
+    const fs::path rel = fs::relative(file, dir.empty() ? "." : dir, ec);
+    return ec || rel.empty() ? file : rel.string();
+}
+
+} // namespace
 
 void writeScene(const String& path, const VirtualScene& scene)
 {
@@ -285,11 +304,7 @@ void writeScene(const String& path, const VirtualScene& scene)
             if (!o.shape.empty())
                 out << "shape" << o.shape;
             else
-            {
-                std::error_code ec;
-                const fs::path rel = fs::relative(o.meshFile, dir.empty() ? "." : dir, ec);
-                out << "mesh" << (ec || rel.empty() ? o.meshFile : rel.string());
-            }
+                out << "mesh" << relativeTo(o.meshFile, dir);
             const char* helper = o.placement == SceneObject::PLACE_BESIDE ? "on_ground_beside"
                                  : o.placement == SceneObject::PLACE_BEHIND ? "behind"
                                  : o.placement == SceneObject::PLACE_IN_FRONT ? "in_front_of"
@@ -309,6 +324,20 @@ void writeScene(const String& path, const VirtualScene& scene)
             out << "rotation" << "[:" << o.rotationDeg[0] << o.rotationDeg[1]
                 << o.rotationDeg[2] << "]";
             out << "scale" << "[:" << o.scale[0] << o.scale[1] << o.scale[2] << "]";
+            if (!o.material.empty())
+            {
+                const SceneObject::MaterialOverride& mo = o.material;
+                out << "material" << "{:";
+                if (mo.hasDiffuse)
+                    out << "diffuse" << "[:" << mo.diffuse[0] << mo.diffuse[1] << mo.diffuse[2]
+                        << "]";
+                if (mo.hasAmbient)
+                    out << "ambient" << "[:" << mo.ambient[0] << mo.ambient[1] << mo.ambient[2]
+                        << "]";
+                if (!mo.texture.empty())
+                    out << "texture" << relativeTo(mo.texture, dir);
+                out << "}";
+            }
             out << "}";
         }
         out << "]";

@@ -52,6 +52,17 @@ struct CV_EXPORTS SceneObject
     double distance = 0.25;              //!< helpers: gap to the clone in clone sizes
     int side = 1;                        //!< PLACE_BESIDE: +1 right, -1 left (as seen)
     Vec3d offset = Vec3d(0, 0, 0);       //!< helpers: extra shift, ground axes, clone sizes
+    /** The file's `material` overrides, as given (already applied to `meshes`), kept so that
+    writeScene() writes them back. */
+    struct MaterialOverride
+    {
+        bool hasDiffuse = false;         //!< `diffuse` given
+        Vec3f diffuse;                   //!< RGB in [0, 1]
+        bool hasAmbient = false;         //!< `ambient` given
+        Vec3f ambient;                   //!< RGB in [0, 1]
+        String texture;                  //!< `texture`: the image file (resolved) or empty
+        bool empty() const { return !hasDiffuse && !hasAmbient && texture.empty(); }
+    } material;
 };
 
 //! A parsed scene file.
