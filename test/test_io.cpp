@@ -696,5 +696,85 @@ TEST(Augocc_FrameSource, bad_arg)
     expectErrorMentions([&] { src->read(f); }, {"0001.png", "32x20"});
 }
 
+TEST(Augocc_FrameSource, regression_input_replaced_while_read)
+{
+    // An input replaced or rewritten between open() and the last read() gave an output made of
+    // two versions of it, with no word said (issue 17). Each way a file changes is named.
+    const std::string dir = tempDir("io_replaced");
+    auto writeFrames = [&](const std::string& folder) {
+        fs::remove_all(folder);
+        fs::create_directories(folder);
+        cv::RNG rng(7);
+        for (int i = 0; i < 5; i++)
+        {
+            Mat m(48, 64, CV_8UC3);
+            rng.fill(m, cv::RNG::UNIFORM, 0, 255);
+            cv::imwrite(cv::format("%s/%04d.png", folder.c_str(), i), m);
+        }
+    };
+    const std::string frames = dir + "/frames";
+    writeFrames(frames);
+    const Mat other(48, 64, CV_8UC3, Scalar::all(9));
+    for (const std::string& input : {frames, frames + "/%04d.png"})
+    {
+        // Replaced (a new file renamed over it, as editors and sync tools do).
+        Ptr<FrameSource> src = FrameSource::open(input);
+        Mat f;
+        ASSERT_TRUE(src->read(f));
+        EXPECT_NO_THROW(src->checkUnchanged());
+        cv::imwrite(dir + "/new.png", other);
+        fs::rename(dir + "/new.png", frames + "/0003.png");
+        expectErrorMentions([&] { src->checkUnchanged(); },
+                            {input, frames + "/0003.png", "replaced", "two versions"});
+        // Rewritten in place (same inode, another size).
+        writeFrames(frames);
+        src = FrameSource::open(input);
+        {
+            std::ofstream(frames + "/0001.png", std::ios::app) << "appended";
+        }
+        expectErrorMentions([&] { src->checkUnchanged(); }, {frames + "/0001.png", "rewritten"});
+        // Removed.
+        writeFrames(frames);
+        src = FrameSource::open(input);
+        fs::remove(frames + "/0004.png");
+        expectErrorMentions([&] { src->checkUnchanged(); }, {frames + "/0004.png", "removed"});
+        writeFrames(frames);
+    }
+    // A video replaced while read (seek() opens it again by name).
+    const std::string video = dir + "/v.avi";
+    auto writeVideo = [&](const std::string& path, int value) {
+        VideoWriter w(path, VideoWriter::fourcc('M', 'J', 'P', 'G'), 25, Size(32, 24));
+        ASSERT_TRUE(w.isOpened());
+        for (int i = 0; i < 4; i++)
+            w.write(Mat(24, 32, CV_8UC3, Scalar::all(value)));
+    };
+    writeVideo(video, 50);
+    Ptr<FrameSource> v = FrameSource::open(video);
+    Mat f;
+    while (v->read(f))
+        ;
+    EXPECT_NO_THROW(v->checkUnchanged());
+    writeVideo(dir + "/w.avi", 200);
+    fs::rename(dir + "/w.avi", video);
+    expectErrorMentions([&] { v->checkUnchanged(); }, {video, "replaced"});
+    // The tracker checks before it returns tracks: a frame replaced half-way is an error.
+    writeFrames(frames);
+    FeatureTracker::Params tp;
+    bool replaced = false;
+    tp.progress = [&](const Progress& p) {
+        if (replaced || p.done < 2)
+            return;
+        cv::imwrite(dir + "/new.png", other);
+        fs::rename(dir + "/new.png", frames + "/0004.png");
+        replaced = true;
+    };
+    Tracks tracks;
+    expectErrorMentions([&] { FeatureTracker::create(tp)->track(FrameSource::open(frames),
+                                                                  tracks); },
+                        {frames + "/0004.png", "replaced"});
+    EXPECT_TRUE(replaced);
+    EXPECT_EQ(0, tracks.frames());
+}
+
 } // namespace
 } // namespace opencv_test

@@ -82,6 +82,7 @@ void runClone(const CloneOptions& o, const Globals& g)
             if (rec.findCamera(f) >= 0)
                 frames[f] = img;
         }
+        src->checkUnchanged();  // frames of two versions would carve a wrong clone
     }
     ProgressPrinter progress(g);
     p.progress = progress.callback();

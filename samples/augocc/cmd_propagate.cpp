@@ -117,6 +117,7 @@ void runPropagate(const Options& opt, const Globals& g)
         progress.report("propagate", ++done, (long long)frames.size(), "frames");
     }
     progress.finish();
+    source->checkUnchanged();  // masks snapped to two versions of the footage are not kept
     for (const std::string& name : wanted)
         if (!out.count(name))
             throw UsageError("--object " + name + ": no such object in the " +

@@ -318,6 +318,7 @@ public:
         if (s.frames() < 2)
             CV_Error(Error::StsBadArg, cv::format("FeatureTracker: the input has %d frame(s); "
                      "tracking needs at least 2", s.frames()));
+        source->checkUnchanged();  // tracks of two versions of the input are no tracks
         out = s.finish();
     }
 

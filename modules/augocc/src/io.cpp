@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cstdio>
 #include <numeric>
+#include <sys/stat.h>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -876,7 +877,51 @@ void writeMasks(const String& dir, const ObjectMasks& masks)
 
 FrameSource::~FrameSource() {}
 
+void FrameSource::checkUnchanged() const {}
+
 namespace {
+
+//! What FrameSource::checkUnchanged() compares: a file's size, modification time and inode.
+struct FileStamp
+{
+    String path;
+    long long size = -1, mtimeNs = -1, inode = -1;
+
+    static FileStamp of(const String& path)
+    {
+        FileStamp s;
+        s.path = path;
+        struct stat st;
+        if (::stat(path.c_str(), &st) == 0)
+        {
+            s.size = (long long)st.st_size;
+            s.mtimeNs = (long long)st.st_mtim.tv_sec * 1000000000LL + st.st_mtim.tv_nsec;
+            s.inode = (long long)st.st_ino;
+        }
+        return s;
+    }
+    bool operator==(const FileStamp& o) const
+    {
+        return size == o.size && mtimeNs == o.mtimeNs && inode == o.inode;
+    }
+};
+
+//! Throws when any of `stamps` differs from its file now (FrameSource::checkUnchanged()).
+void checkStamps(const String& input, const std::vector<FileStamp>& stamps)
+{
+    for (const FileStamp& then : stamps)
+    {
+        const FileStamp now = FileStamp::of(then.path);
+        if (now == then)
+            continue;
+        const String how = now.size < 0 ? "was removed" : now.inode != then.inode
+                                                            ? "was replaced by another file"
+                                                            : "was rewritten";
+        CV_Error(Error::StsError, input + ": " + then.path + " " + how + " while augocc read "
+                 "it: the frames read belong to two versions of the input, so nothing made "
+                 "from them is kept; run again when the input is complete");
+    }
+}
 
 class ImageListSource CV_FINAL : public FrameSource
 {
@@ -884,6 +929,9 @@ public:
     ImageListSource(const String& input, std::vector<String> files)
         : input_(input), files_(std::move(files))
     {
+        stamps_.reserve(files_.size());
+        for (const String& f : files_)
+            stamps_.push_back(FileStamp::of(f));
         Mat first = detail::readImageChecked(files_[0], IMREAD_COLOR);
         if (first.empty())
             CV_Error(Error::StsParseError, files_[0] + ": cannot read image (corrupt or not an "
@@ -913,9 +961,12 @@ public:
         return true;
     }
 
+    void checkUnchanged() const CV_OVERRIDE { checkStamps(input_, stamps_); }
+
 private:
     String input_;
     std::vector<String> files_;
+    std::vector<FileStamp> stamps_;  //!< of files_, when opened
     Size size_;
     int pos_ = 0;
 };
@@ -923,7 +974,7 @@ private:
 class VideoSource CV_FINAL : public FrameSource
 {
 public:
-    explicit VideoSource(const String& path) : path_(path)
+    explicit VideoSource(const String& path) : path_(path), stamps_{FileStamp::of(path)}
     {
         open();
         Mat first;
@@ -974,6 +1025,7 @@ public:
         pos_++;
         return true;
     }
+    void checkUnchanged() const CV_OVERRIDE { checkStamps(path_, stamps_); }
 
 private:
     void open()
@@ -986,6 +1038,7 @@ private:
     }
 
     String path_;
+    std::vector<FileStamp> stamps_;  //!< of path_, when opened (seek() may open it again)
     VideoCapture cap_;
     Size size_;
     int count_ = 0;

@@ -223,6 +223,7 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
                                      fsd << "scale" << enc.scale << "offset" << enc.offset;
                                  },
                                  (fs::path(options.depthDir) / "depth.yml").string());
+    src->checkUnchanged();  // a composite of two versions of the footage is not kept
     out.commit();
     if (mattesOut)
         mattesOut->commit();

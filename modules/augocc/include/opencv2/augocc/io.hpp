@@ -265,6 +265,12 @@ public:
     virtual int position() const = 0;
     //! Seeks so that the next read() returns frame `index`.
     virtual void seek(int index) = 0;
+    /** @brief Throws StsError naming the input and the file when a file it reads was replaced or
+    rewritten since open() (another size, modification time or inode): frames read before and
+    after the change belong to two versions, and an output made from them is a mixture. Call it
+    after the last read() and before committing an output (the module's stages do). The
+    default checks nothing (a source that is not made of files). */
+    virtual void checkUnchanged() const;
 };
 
 /** @brief Writes `path` all or nothing: `writer(tmpPath)` writes a temporary sibling
