@@ -28,7 +28,7 @@ const char* const kWindow = "augocc annotate";
 // A click within this distance of an anchor grabs it (window pixels, whatever the zoom: about a
 // fingertip on a mouse).
 const double kGrabRadius = 6.0;
-// One zoom key press or wheel notch (120 units of Qt's delta) scales the view by this.
+// One zoom key press scales the view by this.
 const double kZoomStep = 1.25;
 const int kStatusHeight = 46;   // two text lines under the frame
 const int kTimelineHeight = 10; // key-frame ruler under the text
@@ -49,7 +49,7 @@ const char* const kHelp[][2] = {
     {"o  /  a", "next object  /  add an object"},
     {"s  /  q, Esc", "save masks  /  save and quit"},
     {"w  /  h", "save a screenshot  /  this help"},
-    {"wheel, +  /  -", "zoom in  /  out about the cursor"},
+    {"+  /  -", "zoom in  /  out about the cursor"},
     {"0  /  1", "fit the frame to the window  /  zoom 100% (1:1)"},
     {"middle drag", "pan (also Ctrl + left drag)"},
 };
@@ -318,11 +318,8 @@ private:
         const bool onView = Rect(Point(), viewport_.getViewSize()).contains(w);
         const Point p = viewport_.imagePixelAt(w);
         const bool onFrame = onView && Rect(Point(), frameSize_).contains(p);
-        if (event == EVENT_MOUSEWHEEL && onView)
-        {
-            zoomAbout(std::pow(kZoomStep, getMouseWheelDelta(flags) / 120.0), w);
-            return;
-        }
+        // The wheel is not bound: Qt's highgui magnifies its own view on it (a second zoom
+        // that would push the status lines out of the window), whatever the callback does.
         if (event == EVENT_MBUTTONDOWN ||
             (event == EVENT_LBUTTONDOWN && (flags & EVENT_FLAG_CTRLKEY)))
         {
@@ -746,7 +743,7 @@ void registerAnnotate(CLI::App& app, Globals& g)
                     "where the w key saves screenshots (default: beside MASKS)");
     sub->add_option("--max-window", opt->maxWindow,
                     "largest window, WIDTHxHEIGHT: a larger frame is shown scaled to fit (zoom "
-                    "in with the wheel or +)")->capture_default_str();
+                    "in with + about the cursor)")->capture_default_str();
     sub->callback([opt, &g]() {
         requireFile("--input", opt->input);
         if (!opt->tracks.empty())

@@ -85,7 +85,7 @@ struct CV_EXPORTS RunOptions
     /** Frames processed: [firstFrame, endFrame) of the input (`augocc run --frames a:b`, half-
     open), at least three (camera recovery needs three views). Every output keeps the input's
     frame numbers (tracks.yml has endFrame frames, the first firstFrame of them empty; cameras,
-    mattes/<object>/%04d.png and the composite cover firstFrame..endFrame-1). Key-frame masks
+    `mattes/<object>/%04d.png` and the composite cover firstFrame..endFrame-1). Key-frame masks
     outside the range are ignored (RunResult::ignoredMasks); an object with none inside it is
     an error. */
     int firstFrame = 0;
