@@ -229,6 +229,12 @@ TEST(Augocc_AnnotateE2e, bad_input)
     EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
                             "/m --frame 3", &out));
     EXPECT_NE(std::string::npos, out.find("--frame")) << out;
+    for (const char* bad : {"100x50", "1600", "0x900"})
+    {
+        EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                                "/m --max-window " + bad, &out)) << bad;
+        EXPECT_NE(std::string::npos, out.find("--max-window")) << bad << ": " << out;
+    }
     std::ofstream(dir + "/c.yml.gz") << "not a clone file";
     EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
                             "/m --clones " + dir + "/c.yml.gz", &out));
