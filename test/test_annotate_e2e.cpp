@@ -229,6 +229,12 @@ TEST(Augocc_AnnotateE2e, bad_input)
     EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
                             "/m --frame 3", &out));
     EXPECT_NE(std::string::npos, out.find("--frame")) << out;
+    for (const char* bad : {"100x50", "1600", "0x900"})
+    {
+        EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
+                                "/m --max-window " + bad, &out)) << bad;
+        EXPECT_NE(std::string::npos, out.find("--max-window")) << bad << ": " << out;
+    }
     std::ofstream(dir + "/c.yml.gz") << "not a clone file";
     EXPECT_EQ(2, runCommand(bin + " --input " + dir + "/frames --masks " + dir +
                             "/m --clones " + dir + "/c.yml.gz", &out));
@@ -278,6 +284,182 @@ TEST(Augocc_AnnotateE2e, suggest_prints_key_frames)
     EXPECT_EQ(suggestKeyFrames(scene.tracks, scene.groundTruth, 3), keys) << out;
     EXPECT_EQ(0, keys.front());
     EXPECT_EQ(sp.frames - 1, keys.back());
+    fs::remove_all(dir);
+}
+
+} // namespace
+} // namespace opencv_test
+
+namespace opencv_test {
+namespace {
+using namespace cv;
+using namespace cv::augocc;
+using namespace x11;
+
+// The last "view scale S offset X Y" line of annotate's log (window pixel w shows frame point
+// (w - offset) / scale) and how many there are.
+int lastView(const std::string& log, double& scale, Point2d& offset)
+{
+    const std::string tag = "annotate: view scale ";
+    int n = 0;
+    for (size_t at = log.find(tag); at != std::string::npos; at = log.find(tag, at + 1))
+    {
+        if (log.find('\n', at) == std::string::npos)
+            break;
+        std::istringstream is(log.substr(at + tag.size()));
+        std::string word;
+        is >> scale >> word >> offset.x >> offset.y;
+        n++;
+    }
+    return n;
+}
+
+bool waitForViews(const std::string& log, int count, double timeoutS)
+{
+    double s;
+    Point2d o;
+    for (int i = 0; i < timeoutS * 10; ++i)
+    {
+        if (lastView(readFile(log), s, o) >= count)
+            return true;
+        sleepMs(100);
+    }
+    return false;
+}
+
+// 1080p frames in the default window (--max-window 1600x900: the frame scaled to fit), zoomed
+// about the cursor with the + key (three presses), panned with a middle-button drag: the
+// clicks xdotool makes land on the intended frame pixels. Straight segments (no click snap), so
+// the saved mask must equal, pixel for pixel, the library's mask of those frame pixels.
+TEST(Augocc_AnnotateE2e, xvfb_zoomed_1080p_clicks_land_on_frame_pixels)
+{
+    if (!haveTool("Xvfb") || !haveTool("xdotool"))
+        GTEST_SKIP() << "Xvfb or xdotool not installed (scripts/setup.sh installs xvfb xdotool)";
+    const std::string bin = augoccBinary();
+    if (!fs::exists(bin))
+        GTEST_SKIP() << "augocc binary not built: " << bin;
+    const char* shotsEnv = std::getenv("AUGOCC_ANNOTATE_SHOTS");
+    const std::string shots = shotsEnv ? shotsEnv : "";
+    if (!shots.empty() && !haveTool("ffmpeg"))
+        GTEST_SKIP() << "AUGOCC_ANNOTATE_SHOTS set but ffmpeg missing";
+
+    const std::string dir = tempDir("annotate_zoom");
+    fs::create_directories(dir + "/frames");
+    SceneSynthesizer::Params sp;
+    sp.frames = 2;
+    sp.numKeyFrames = 2;
+    sp.numTracks = 50;
+    sp.imageSize = Size(1920, 1080);
+    SyntheticScene scene;
+    SceneSynthesizer::create(sp)->synthesize(scene);
+    for (int f = 0; f < sp.frames; ++f)
+        ASSERT_TRUE(imwrite(format("%s/frames/%04d.png", dir.c_str(), f), scene.frames[f]));
+    const std::string masks = dir + "/masks";
+
+    Child xvfb;
+    std::string why;
+    const std::string display = startXvfb(xvfb, dir, why, "1920x1080x24");
+    ASSERT_FALSE(display.empty()) << why;
+    Child tool;
+    const std::string log = dir + "/annotate.log";
+    tool.pid = spawn({bin, "annotate", "--input", dir + "/frames", "--masks", masks, "--object",
+                      "building", "--screenshot-dir", dir},
+                     {"DISPLAY=" + display, "QT_QPA_PLATFORM=xcb"}, log);
+    ASSERT_GT(tool.pid, 0);
+    Rect rect;
+    ASSERT_TRUE(waitForWindowRect(tool, log, kStartTimeoutS, rect, why)) << why;
+    // The frame scaled to fit 1600 x (900 - the status lines), ImageViewport::fitViewSize.
+    const Size view = ImageViewport::fitViewSize(sp.imageSize, Size(1600, 900 - 56));
+    ASSERT_EQ(view.width, rect.width) << readFile(log);
+    ASSERT_GE(rect.height, view.height);
+    ASSERT_TRUE(waitForViews(log, 1, 5)) << readFile(log);
+    sleepMs(300);
+
+    Xdo xdo(display);
+    const Point origin = rect.tl();
+    // Zoom about a point left of the building's centre: + three times.
+    const Rect bbox = boundingRect(scene.visibleMasks.at("building").at(0));
+    double scale0;
+    Point2d offset0;
+    lastView(readFile(log), scale0, offset0);
+    const Point2d c = scale0 * Point2d(bbox.x + 0.3 * bbox.width, bbox.y + 0.5 * bbox.height) +
+                      offset0;
+    const Point cursor(cvRound(c.x), cvRound(c.y));
+    xdo.moveTo(origin + cursor);
+    xdo.key("plus");
+    xdo.key("plus");
+    xdo.key("plus");
+    ASSERT_TRUE(waitForViews(log, 4, 10)) << "no zoom from +:\n" << readFile(log);
+    // Pan: drag with the middle button 80 px left and 50 px up.
+    xdo.run("mousedown 2");
+    sleepMs(100);
+    xdo.moveTo(origin + cursor + Point(-80, -50));
+    xdo.run("mouseup 2");
+    sleepMs(300);
+    double scale;
+    Point2d offset;
+    const int views = lastView(readFile(log), scale, offset);
+    ASSERT_GE(views, 5) << "no pan:\n" << readFile(log);
+    // 1.25^3 over the fit (0.78): 1.53 window pixels per frame pixel.
+    const double kZoomed = scale0 * 1.25 * 1.25 * 1.25;
+    EXPECT_NEAR(kZoomed, scale, 1e-6 * kZoomed);
+    // The frame point under the cursor stayed there while zooming; the drag moved it by the drag.
+    const Point2d under = (Point2d(cursor) - offset0) * (1.0 / scale0);
+    EXPECT_LE(norm(scale * under + offset - Point2d(cursor + Point(-80, -50))), 1e-3);
+
+    // Five frame pixels spread over what the view shows now; the window pixel that shows each.
+    const Point2d lo = (Point2d(0, 0) - offset) * (1.0 / scale);
+    const Point2d hi = (Point2d(view.width - 1, view.height - 1) - offset) * (1.0 / scale);
+    const double fx[] = {0.2, 0.7, 0.85, 0.5, 0.15}, fy[] = {0.2, 0.15, 0.6, 0.85, 0.7};
+    std::vector<Point> pixels, clicks;
+    for (int i = 0; i < 5; ++i)
+    {
+        const Point q(cvRound(lo.x + fx[i] * (hi.x - lo.x)), cvRound(lo.y + fy[i] * (hi.y - lo.y)));
+        const Point2d v = scale * Point2d(q) + offset;
+        const Point w(cvRound(v.x), cvRound(v.y));
+        // That window pixel shows q: its centre lies within q's area (scale > 1).
+        ASSERT_EQ(q.x, (int)std::floor((w.x - offset.x) / scale + 0.5));
+        ASSERT_EQ(q.y, (int)std::floor((w.y - offset.y) / scale + 0.5));
+        pixels.push_back(q);
+        clicks.push_back(w);
+    }
+    xdo.key("l");  // straight segments: clicks are not snapped to edges
+    for (size_t i = 0; i < clicks.size(); ++i)
+        xdo.click(origin + clicks[i]);
+    if (!shots.empty())
+    {
+        xdo.moveTo(origin + (clicks[0] + clicks[4]) / 2);
+        sleepMs(400);
+        grab(display, rect, shots + "/annotate_zoom.png");
+        xdo.key("h");
+        sleepMs(300);
+        grab(display, rect, shots + "/annotate_zoom_help.png");
+        xdo.key("h");
+    }
+    xdo.key("c");  // close
+    xdo.key("q");  // save and quit
+    const int rc = tool.wait(kExitTimeoutS);
+    const std::string text = readFile(log);
+    ASSERT_EQ(0, rc) << "augocc annotate did not exit cleanly:\n" << text;
+    xvfb.stop();
+
+    const Mat written = imread(masks + "/building/0000.png", IMREAD_GRAYSCALE);
+    ASSERT_FALSE(written.empty()) << "no mask written:\n" << text;
+    Ptr<SilhouetteEditor> ed = SilhouetteEditor::create();
+    ed->setImage(scene.frames[0]);
+    ed->setSegmentMode(SilhouetteEditor::STRAIGHT);
+    for (const Point& q : pixels)
+        EXPECT_EQ(q, ed->addPoint(q));
+    ASSERT_TRUE(ed->closeContour());
+    Mat headless;
+    ed->getMask(headless);
+    std::cout << format("[ annotate zoom ] 1920x1080 in a %dx%d view, scale %.4f (fit %.4f); "
+                        "mask %d px, differing from the library's: %d px",
+                        view.width, view.height, scale, scale0, countNonZero(headless),
+                        countNonZero(written != headless))
+              << std::endl;
+    EXPECT_GT(countNonZero(headless), 1000);
+    EXPECT_EQ(0, norm(written, headless, NORM_INF)) << "clicks did not land on the frame pixels";
     fs::remove_all(dir);
 }
 

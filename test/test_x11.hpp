@@ -208,8 +208,10 @@ inline bool waitForWindowRect(Child& tool, const std::string& log, double timeou
 }
 
 /** Starts Xvfb on a free display number; waits for its socket.
+@param screen the screen, WIDTHxHEIGHTxDEPTH.
 @return the display (":N"), empty on failure (with the reason in `why`). */
-inline std::string startXvfb(Child& xvfb, const std::string& dir, std::string& why)
+inline std::string startXvfb(Child& xvfb, const std::string& dir, std::string& why,
+                             const std::string& screen = "1024x768x24")
 {
     const int dispNum = freeDisplay();
     if (dispNum < 0)
@@ -218,7 +220,7 @@ inline std::string startXvfb(Child& xvfb, const std::string& dir, std::string& w
         return std::string();
     }
     const std::string display = format(":%d", dispNum);
-    xvfb.pid = spawn({"Xvfb", display, "-screen", "0", "1024x768x24", "-nolisten", "tcp"}, {},
+    xvfb.pid = spawn({"Xvfb", display, "-screen", "0", screen, "-nolisten", "tcp"}, {},
                      dir + "/xvfb.log");
     const std::string socket = format("/tmp/.X11-unix/X%d", dispNum);
     for (int i = 0; i < 200 && !fs::exists(socket); ++i)

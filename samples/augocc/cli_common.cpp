@@ -236,6 +236,26 @@ std::vector<FrameRange> parseFrameRanges(const std::string& flag, const std::str
     return ranges;
 }
 
+cv::Size parseSize(const std::string& flag, const std::string& text)
+{
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 ||
+        (x != 'x' && x != 'X') || w <= 0 || h <= 0)
+        throw UsageError(flag + " " + text + ": expected WIDTHxHEIGHT, e.g. 640x480");
+    return cv::Size(w, h);
+}
+
+FrameRange parseFrameSpan(const std::string& flag, const std::string& text,
+                          const std::string& command)
+{
+    const std::vector<FrameRange> r = parseFrameRanges(flag, text);
+    if (r.size() != 1 || r[0].step != 1)
+        throw UsageError(flag + " " + text + ": " + command + " takes one range of consecutive "
+                         "frames (a, a:b or a:)");
+    return r[0];
+}
+
 std::set<int> listFrames(const std::string& flag, const std::string& text,
                          const std::vector<FrameRange>& ranges, int frameCount)
 {

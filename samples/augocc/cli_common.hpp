@@ -82,6 +82,10 @@ void setIntrinsicsOptions(const std::string& calibration, double focal, bool ref
 //! The lens line of the sfm log: model, focal, coefficients and the reason.
 std::string lensLine(const cv::augocc::SfmReport& report);
 
+//! A size written WIDTHxHEIGHT (`--size 640x480`, `--max-window 1600x900`), both positive;
+//! UsageError naming the flag otherwise.
+cv::Size parseSize(const std::string& flag, const std::string& text);
+
 //! One item of a frame list: frames first, first + step, ... before end.
 struct FrameRange
 {
@@ -102,6 +106,15 @@ Throws UsageError naming the flag and the item on anything else: an empty item, 
 not a non-negative integer, b <= a, s < 1.
 */
 std::vector<FrameRange> parseFrameRanges(const std::string& flag, const std::string& text);
+
+/** @brief One range of consecutive frames, as `composite --frames` and `run --frames` take it:
+`a` (one frame), `a:b` (frames a..b-1, half-open) or `a:` (a to the last frame); parsed by
+parseFrameRanges(). Throws UsageError naming the flag and `command` for a list or a step.
+@param flag the flag (`--frames`). @param text its value. @param command the sub-command, named
+in the message.
+*/
+FrameRange parseFrameSpan(const std::string& flag, const std::string& text,
+                          const std::string& command);
 
 /** @brief The frames of `ranges` in an input of `frameCount` frames, sorted, each once.
 Throws UsageError naming `flag` when a frame of them is at or past `frameCount`.

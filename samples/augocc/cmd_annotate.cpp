@@ -25,8 +25,11 @@ using namespace cv;
 using namespace cv::augocc;
 
 const char* const kWindow = "augocc annotate";
-// A click within this distance of an anchor grabs it (pixels; about a fingertip on a mouse).
+// A click within this distance of an anchor grabs it (window pixels, whatever the zoom: about a
+// fingertip on a mouse).
 const double kGrabRadius = 6.0;
+// One zoom key press scales the view by this.
+const double kZoomStep = 1.25;
 const int kStatusHeight = 46;   // two text lines under the frame
 const int kTimelineHeight = 10; // key-frame ruler under the text
 
@@ -46,11 +49,15 @@ const char* const kHelp[][2] = {
     {"o  /  a", "next object  /  add an object"},
     {"s  /  q, Esc", "save masks  /  save and quit"},
     {"w  /  h", "save a screenshot  /  this help"},
+    {"+  /  -", "zoom in  /  out about the cursor"},
+    {"0  /  1", "fit the frame to the window  /  zoom 100% (1:1)"},
+    {"middle drag", "pan (also Ctrl + left drag)"},
 };
 
 struct Options
 {
     std::string input, masks, tracks, reconstruction, clones, screenshotDir;
+    std::string maxWindow = "1600x900";
     std::vector<std::string> objects;
     int frame = 0, suggest = 0;
 };
@@ -58,7 +65,8 @@ struct Options
 class AnnotateApp
 {
 public:
-    AnnotateApp(const Options& o, const Globals& g) : opt_(o), g_(g) {}
+    AnnotateApp(const Options& o, const Globals& g, Size maxView)
+        : opt_(o), g_(g), maxView_(maxView) {}
 
     void run()
     {
@@ -100,14 +108,17 @@ public:
             throw UsageError("annotate opens a window and needs a display: set DISPLAY (or run "
                              "it under xvfb-run)");
 
+        viewport_ = ImageViewport(frameSize_, ImageViewport::fitViewSize(frameSize_, maxView_));
         namedWindow(kWindow, WINDOW_AUTOSIZE | WINDOW_GUI_NORMAL);
         setMouseCallback(kWindow, &AnnotateApp::onMouse, this);
         render();
         waitKey(50);
         // Where the frame lies on the screen: tests and scripts driving the window with
-        // xdotool read this line (the image is shown 1:1 from the rectangle's top-left).
+        // xdotool read this line, and the view lines (the window pixel at the rectangle's
+        // top-left + p shows frame point (p - offset) / scale, ImageViewport).
         const Rect r = getWindowImageRect(kWindow);
         info(g_, format("annotate: window image rect %d %d %d %d", r.x, r.y, r.width, r.height));
+        logView();
         bool quit = false;
         while (!quit)
         {
@@ -300,11 +311,32 @@ private:
         static_cast<AnnotateApp*>(self)->mouse(event, Point(x, y), flags);
     }
 
-    void mouse(int event, Point p, int)
+    // Window pixel w: the view shows frame pixel p = viewport_.imagePixelAt(w); the editor works
+    // in frame pixels only.
+    void mouse(int event, Point w, int flags)
     {
-        const bool onFrame = Rect(Point(), frameSize_).contains(p);
+        const bool onView = Rect(Point(), viewport_.getViewSize()).contains(w);
+        const Point p = viewport_.imagePixelAt(w);
+        const bool onFrame = onView && Rect(Point(), frameSize_).contains(p);
+        // The wheel is not bound: Qt's highgui magnifies its own view on it (a second zoom
+        // that would push the status lines out of the window), whatever the callback does.
+        if (event == EVENT_MBUTTONDOWN ||
+            (event == EVENT_LBUTTONDOWN && (flags & EVENT_FLAG_CTRLKEY)))
+        {
+            panFrom_ = w;
+            return;
+        }
+        if (panFrom_.x >= 0 && (event == EVENT_MBUTTONUP || event == EVENT_LBUTTONUP))
+        {
+            panTo(w);
+            panFrom_ = Point(-1, -1);
+            return;
+        }
         if (event == EVENT_MOUSEMOVE)
         {
+            if (panFrom_.x >= 0)
+                panTo(w);
+            cursorView_ = onView ? w : Point(-1, -1);
             cursor_ = onFrame ? p : Point(-1, -1);
             dirty_ = true;
             return;
@@ -318,12 +350,12 @@ private:
             {
                 const int open = editor_->getContourCount() - 1;
                 const std::vector<Point> anchors = editor_->getAnchors(open);
-                if (anchors.size() >= 3 && norm(anchors.front() - p) <= kGrabRadius)
+                if (anchors.size() >= 3 && norm(anchors.front() - p) <= grabRadius())
                     editor_->closeContour();
                 else
                     editor_->addPoint(p);
             }
-            else if (editor_->findAnchor(p, kGrabRadius, c, a))
+            else if (editor_->findAnchor(p, grabRadius(), c, a))
             {
                 dragContour_ = c;
                 dragAnchor_ = a;
@@ -345,10 +377,49 @@ private:
             int c, a;
             if (editor_->hasOpenContour())
                 editor_->closeContour();
-            else if (editor_->findAnchor(p, kGrabRadius, c, a))
+            else if (editor_->findAnchor(p, grabRadius(), c, a))
                 editor_->removeAnchor(c, a);
             dirty_ = true;
         }
+    }
+
+    // kGrabRadius window pixels in frame pixels (at least one frame pixel).
+    double grabRadius() const { return std::max(1.0, kGrabRadius / viewport_.getScale()); }
+
+    void panTo(Point w)
+    {
+        viewport_.pan(Point2d(w - panFrom_));
+        panFrom_ = w;
+        viewChanged();
+    }
+
+    // Zoom about window pixel w (the view's centre when the cursor is not over it).
+    void zoomAbout(double factor, Point w)
+    {
+        const Size v = viewport_.getViewSize();
+        const Point2d at = w.x >= 0 ? Point2d(w) : Point2d(0.5 * (v.width - 1),
+                                                           0.5 * (v.height - 1));
+        viewport_.zoomBy(factor, at);
+        viewChanged();
+    }
+
+    void viewChanged()
+    {
+        // The cursor now shows another frame pixel.
+        if (cursorView_.x >= 0)
+        {
+            const Point p = viewport_.imagePixelAt(cursorView_);
+            cursor_ = Rect(Point(), frameSize_).contains(p) ? p : Point(-1, -1);
+        }
+        dirty_ = true;
+        logView();
+    }
+
+    void logView()
+    {
+        const Point2d o = viewport_.getOffset();
+        info(g_, format("annotate: view scale %.9g offset %.9g %.9g", viewport_.getScale(), o.x,
+                        o.y));
     }
 
     // Returns true to quit. Qt's highgui reports letters upper-case and other keys as X keysyms.
@@ -386,13 +457,13 @@ private:
                 status_ = "nothing to redo";
             break;
         case 'i':
-            if (cursor_.x < 0 || !editor_->insertAnchor(cursor_, 3 * kGrabRadius))
+            if (cursor_.x < 0 || !editor_->insertAnchor(cursor_, 3 * grabRadius()))
                 status_ = "no segment near the cursor";
             break;
         case 'd':
         {
             int c, a;
-            if (cursor_.x >= 0 && editor_->findAnchor(cursor_, kGrabRadius, c, a))
+            if (cursor_.x >= 0 && editor_->findAnchor(cursor_, grabRadius(), c, a))
                 editor_->removeAnchor(c, a);
             else
                 status_ = "no anchor under the cursor";
@@ -441,6 +512,19 @@ private:
             break;
         case 'w':
             screenshot();
+            break;
+        case '+': case '=': case 65451:
+            zoomAbout(kZoomStep, cursorView_);
+            break;
+        case '-': case '_': case 65453:
+            zoomAbout(1.0 / kZoomStep, cursorView_);
+            break;
+        case '0':
+            viewport_.fit();
+            viewChanged();
+            break;
+        case '1':
+            zoomAbout(1.0 / viewport_.getScale(), cursorView_);
             break;
         default:
             break;
@@ -524,11 +608,12 @@ private:
     void render()
     {
         dirty_ = false;
-        const int W = frameSize_.width, H = frameSize_.height;
+        const int W = viewport_.getViewSize().width, H = viewport_.getViewSize().height;
         canvas_.create(H + kStatusHeight + kTimelineHeight, W, CV_8UC3);
         canvas_.setTo(Scalar(32, 32, 32));
-        Mat view = canvas_(Rect(0, 0, W, H));
-        image_.copyTo(view);
+        // Silhouettes are drawn on the frame at its own resolution, then the view shows it.
+        image_.copyTo(frameCanvas_);
+        Mat view = frameCanvas_;
         // Other objects' silhouettes of this frame, as thin outlines for context.
         for (size_t o = 0; o < objects_.size(); ++o)
         {
@@ -543,19 +628,22 @@ private:
         }
         const Point cur = dragContour_ >= 0 ? Point(-1, -1) : cursor_;
         editor_->drawOverlay(view, cur);
-        if (dragContour_ >= 0 && cursor_.x >= 0)
-            circle(view, cursor_, 4, Scalar(0, 0, 255), 1, LINE_AA);
+        Mat shown = canvas_(Rect(0, 0, W, H));
+        viewport_.render(frameCanvas_, shown, Scalar(32, 32, 32));
+        if (dragContour_ >= 0 && cursorView_.x >= 0)
+            circle(shown, cursorView_, 4, Scalar(0, 0, 255), 1, LINE_AA);
         if (help_)
-            drawHelp(view);
+            drawHelp(shown);
 
         const bool isKey = keyMarks_[objectName()].count(frame_) > 0;
         const bool hasMask = masks_[objectName()].count(frame_) > 0;
         const std::string line1 = format(
-            "frame %d/%d%s  object %s (%d/%d)  %s  anchors %d%s", frame_, frameCount_ - 1,
+            "frame %d/%d%s  object %s (%d/%d)  %s  anchors %d  zoom %.0f%%%s", frame_,
+            frameCount_ - 1,
             isKey ? (hasMask ? "  KEY (annotated)" : "  KEY (to do)") : "", objectName().c_str(),
             object_ + 1, int(objects_.size()),
             mode_ == SilhouetteEditor::LIVE_WIRE ? "LIVE WIRE" : "STRAIGHT",
-            editor_->getAnchorCount(), modified_ ? "  *" : "");
+            editor_->getAnchorCount(), 100 * viewport_.getScale(), modified_ ? "  *" : "");
         const std::string line2 = status_.empty() ? std::string("h: help   q: save and quit")
                                                   : status_;
         putText(canvas_, line1, Point(6, H + 18), FONT_HERSHEY_SIMPLEX, 0.45,
@@ -614,7 +702,11 @@ private:
     std::map<std::string, std::set<int>> keyMarks_;
     std::map<std::pair<int, int>, Ptr<SilhouetteEditor>> editors_;
     Ptr<SilhouetteEditor> editor_;
-    Mat image_, canvas_;
+    Mat image_, canvas_, frameCanvas_;
+    ImageViewport viewport_;
+    Size maxView_;                     // largest view: --max-window less the status lines
+    Point cursorView_ = Point(-1, -1); // cursor, window pixels
+    Point panFrom_ = Point(-1, -1);    // a pan drag in progress: its last window pixel
     int object_ = 0, frame_ = 0;
     int mode_ = SilhouetteEditor::LIVE_WIRE;
     Point cursor_ = Point(-1, -1);
@@ -649,6 +741,9 @@ void registerAnnotate(CLI::App& app, Globals& g)
                     "--reconstruction)");
     sub->add_option("--screenshot-dir", opt->screenshotDir,
                     "where the w key saves screenshots (default: beside MASKS)");
+    sub->add_option("--max-window", opt->maxWindow,
+                    "largest window, WIDTHxHEIGHT: a larger frame is shown scaled to fit (zoom "
+                    "in with + about the cursor)")->capture_default_str();
     sub->callback([opt, &g]() {
         requireFile("--input", opt->input);
         if (!opt->tracks.empty())
@@ -659,7 +754,12 @@ void registerAnnotate(CLI::App& app, Globals& g)
             requireFile("--clones", opt->clones);
         if (opt->suggest < 0)
             throw UsageError("--suggest must be >= 0");
-        AnnotateApp app(*opt, g);
+        const Size maxWindow = parseSize("--max-window", opt->maxWindow);
+        const int status = kStatusHeight + kTimelineHeight;
+        if (maxWindow.width < 160 || maxWindow.height < status + 120)
+            throw UsageError(format("--max-window %s: at least 160x%d (the frame and %d lines of "
+                                    "status)", opt->maxWindow.c_str(), status + 120, status));
+        AnnotateApp app(*opt, g, Size(maxWindow.width, maxWindow.height - status));
         app.run();
     });
 }

@@ -28,12 +28,9 @@ void runComposite(const Globals& g, const CompositeCliOptions& o)
     CompositeOptions opt;
     if (!o.frames.empty())
     {
-        const std::vector<FrameRange> r = parseFrameRanges("--frames", o.frames);
-        if (r.size() != 1 || r[0].step != 1)
-            throw UsageError("--frames " + o.frames + ": composite takes one range of "
-                             "consecutive frames (a, a:b or a:)");
-        opt.firstFrame = r[0].first;
-        opt.endFrame = r[0].end;
+        const FrameRange r = parseFrameSpan("--frames", o.frames, "composite");
+        opt.firstFrame = r.first;
+        opt.endFrame = r.end;
     }
     const Reconstruction rec = readReconstruction(o.reconstruction);
     const Ptr<CloneSet> clones = CloneSet::load(o.clones);

@@ -13,7 +13,7 @@ namespace {
 
 struct RunCliOptions
 {
-    std::string input, masks, scene, outDir;
+    std::string input, masks, scene, outDir, frames;
     bool hardEdges = false;
     bool antialiasVirtual = false;
     bool noPhotoRefine = false;
@@ -42,6 +42,12 @@ void runRun(const Globals& g, const RunCliOptions& o)
     ro.masksDir = o.masks;
     ro.scenePath = o.scene;
     ro.outDir = o.outDir;
+    if (!o.frames.empty())
+    {
+        const FrameRange fr = parseFrameSpan("--frames", o.frames, "run");
+        ro.firstFrame = fr.first;
+        ro.endFrame = fr.end;
+    }
     ro.supersample = o.hardEdges ? 1 : Compositor::Params().supersample;
     ro.antialiasVirtual = o.antialiasVirtual;
     ro.photoRefine = !o.noPhotoRefine;
@@ -57,6 +63,10 @@ void runRun(const Globals& g, const RunCliOptions& o)
     ro.progress = progress.callback();
     const RunResult r = runPipeline(ro);
     progress.finish();
+    if (!r.ignoredMasks.empty())
+        info(g, cv::format("%d key-frame mask(s) outside --frames %s ignored (first: %s)",
+                           (int)r.ignoredMasks.size(), o.frames.c_str(),
+                           r.ignoredMasks.front().c_str()));
     for (const auto& s : r.stageSeconds)
     {
         const bool reused =
@@ -83,6 +93,9 @@ void registerRun(CLI::App& app, Globals& g)
     sub->add_option("--scene", o->scene, "scene.yml (without it, run stops after the mattes)");
     sub->add_option("--out-dir", o->outDir, "folder for every intermediate and the composite")
         ->required();
+    sub->add_option("--frames", o->frames, "process only frames a..b-1 as a:b (half-open), a: "
+                    "to the end; outputs keep the input's frame numbers, key-frame masks "
+                    "outside are ignored");
     sub->add_flag("--hard-edges", o->hardEdges, "the paper's per-pixel depth test");
     sub->add_flag("--antialias-virtual", o->antialiasVirtual, "also anti-alias the virtual "
                   "objects' own outlines (renders them at 3x: slower)")->excludes("--hard-edges");

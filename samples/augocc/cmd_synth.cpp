@@ -52,16 +52,6 @@ const int kSheetThumbWidth = 320;
 const Scalar kOutlineColours[] = {Scalar(0, 0, 255), Scalar(0, 220, 0), Scalar(255, 80, 0),
                                   Scalar(0, 220, 255), Scalar(255, 0, 255), Scalar(255, 255, 0)};
 
-Size parseSize(const std::string& s)
-{
-    int w = 0, h = 0;
-    char x = 0;
-    if (std::sscanf(s.c_str(), "%d%c%d", &w, &x, &h) != 3 || (x != 'x' && x != 'X') || w <= 0 ||
-        h <= 0)
-        throw UsageError("--size " + s + ": expected WIDTHxHEIGHT, e.g. 640x480");
-    return Size(w, h);
-}
-
 // "k1,k2,p1,p2[,k3...]": OpenCV's coefficients, 4, 5, 8, 12 or 14 of them (the library checks
 // the count and says which).
 std::vector<double> parseDistortion(const std::string& s)
@@ -119,7 +109,7 @@ void runSynth(const Globals& g, const SynthOptions& o)
     p.noiseSigma = o.noise;
     p.partialFraction = o.partial;
     p.outlierFraction = o.outliers;
-    p.imageSize = parseSize(o.size);
+    p.imageSize = parseSize("--size", o.size);
     p.numTracks = o.tracks;
     p.numKeyFrames = o.keyFrames > 0 ? o.keyFrames
                                      : std::min(kDefaults.numKeyFrames, std::max(2, o.frames));

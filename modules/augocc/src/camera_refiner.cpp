@@ -1250,6 +1250,19 @@ void selfCalibrate(const Tracks& tracks, const SfmOptions& options, Reconstructi
 
 Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, SfmReport* report)
 {
+    // The tracks of a sub-range of a shot (`augocc run --frames a:b`) keep the input's frame
+    // numbers, so their first a frames are empty: the stages below see frames 0.. (the
+    // factorization would otherwise solve cameras for frames that observe nothing), and the
+    // cameras get their input frame numbers back.
+    const int firstFrame = tracks.firstObservedFrame();
+    if (firstFrame > 0 && firstFrame < tracks.frames())
+    {
+        Reconstruction rec = recoverCameras(
+            tracks.shiftedFrames(-firstFrame, tracks.frames() - firstFrame), options, report);
+        for (Camera& c : rec.cameras)
+            c.frame += firstFrame;
+        return rec;
+    }
     const String model = options.model;
     if (model != "auto" && model != "scaled_orthographic" && model != "perspective")
         CV_Error(Error::StsBadArg, "--model " + model + ": expected scaled_orthographic, "

@@ -299,6 +299,31 @@ Tracks Tracks::fromObservations(Size imageSize, int frames, int points, const Ma
     return t;
 }
 
+Tracks Tracks::shiftedFrames(int offset, int frames) const
+{
+    if (frames < 0)
+        CV_Error(Error::StsBadArg, cv::format("tracks: %d frames", frames));
+    Tracks out = *this;
+    out.frames_ = frames;
+    for (int i = 0; i < observations(); i++)
+    {
+        out.frame_[i] = frame_[i] + offset;
+        if (out.frame_[i] < 0 || out.frame_[i] >= frames)
+            CV_Error(Error::StsOutOfRange, cv::format("tracks: frame %d moved by %d leaves "
+                     "frames 0..%d", frame_[i], offset, frames - 1));
+    }
+    out.buildFrameIndex();
+    return out;
+}
+
+int Tracks::firstObservedFrame() const
+{
+    for (int f = 0; f < frames_; f++)
+        if (frameObservationCount(f) > 0)
+            return f;
+    return frames_;
+}
+
 Tracks Tracks::mapped(const std::function<Point2f(int, int, const Point2f&)>& fn,
                       Size newImageSize) const
 {

@@ -254,6 +254,31 @@ private:
     int64 t0_ = 0;
 };
 
+// Frames [first, end) of a source as a source of their own (frame 0 = `first`): what the tracker
+// reads for `run --frames a:b`.
+class FrameRangeSource CV_FINAL : public FrameSource
+{
+public:
+    FrameRangeSource(const Ptr<FrameSource>& src, int first, int end)
+        : src_(src), first_(first), end_(end)
+    {
+        src_->seek(first_);
+    }
+    int count() const CV_OVERRIDE { return end_ - first_; }
+    Size size() const CV_OVERRIDE { return src_->size(); }
+    double fps() const CV_OVERRIDE { return src_->fps(); }
+    bool read(OutputArray frame) CV_OVERRIDE
+    {
+        return src_->position() < end_ && src_->read(frame);
+    }
+    int position() const CV_OVERRIDE { return src_->position() - first_; }
+    void seek(int index) CV_OVERRIDE { src_->seek(first_ + index); }
+
+private:
+    Ptr<FrameSource> src_;
+    int first_, end_;
+};
+
 } // namespace
 
 RunResult runPipeline(const RunOptions& o)
@@ -277,10 +302,19 @@ RunResult runPipeline(const RunOptions& o)
     cp.progress = o.progress;
     Ptr<CloneBuilder> builder = CloneBuilder::create(cp);
     Ptr<FrameSource> src = FrameSource::open(o.input);
-    const ObjectMasks masks = readMasks(o.masksDir, src->size());
+    ObjectMasks masks = readMasks(o.masksDir, src->size());
     if (masks.empty())
         CV_Error(Error::StsBadArg, o.masksDir + ": no object folder with masks");
     const int frameCount = src->count();
+    // The frames processed, [first, end): input frame numbers throughout.
+    const int first = o.firstFrame, end = o.endFrame < 0 ? frameCount : o.endFrame;
+    const String framesFlag = cv::format("--frames %d:%d", first, end);
+    if (first < 0 || end > frameCount || first >= end)
+        CV_Error(Error::StsOutOfRange, framesFlag + ": outside " + o.input + cv::format(", which "
+                 "has frames 0:%d (half-open: frames a..b-1)", frameCount));
+    if (end - first < 3)
+        CV_Error(Error::StsOutOfRange, framesFlag + cv::format(": %d frame(s); the camera "
+                 "recovery needs at least 3", end - first));
     for (const auto& obj : masks)
     {
         if (obj.second.empty())
@@ -302,6 +336,26 @@ RunResult runPipeline(const RunOptions& o)
             if (n == (int)fm.second.total())
                 CV_Error(Error::StsBadArg, file + ": the silhouette covers the whole frame");
         }
+    }
+    // Key frames outside the frames processed have no camera in this run: left out, listed in
+    // the result; an object left without any is an error (it would get no clone).
+    for (auto& obj : masks)
+    {
+        for (auto it = obj.second.begin(); it != obj.second.end();)
+        {
+            if (it->first >= first && it->first < end)
+            {
+                ++it;
+                continue;
+            }
+            r.ignoredMasks.push_back((fs::path(o.masksDir) / obj.first /
+                                      cv::format("%04d.png", it->first)).string());
+            it = obj.second.erase(it);
+        }
+        if (obj.second.empty())
+            CV_Error(Error::StsBadArg, framesFlag + ": " + (fs::path(o.masksDir) /
+                     obj.first).string() + " has no key-frame mask in these frames (frames "
+                     "a..b-1): widen the range or move the object's folder out of the masks");
     }
     VirtualScene scene;
     if (!o.scenePath.empty())
@@ -352,6 +406,10 @@ RunResult runPipeline(const RunOptions& o)
     mTrack.stage = "track";
     mTrack.signedInput("input", inputSignature, o.input, inputQuick);
     mTrack.option("tracker", "default");
+    // The range: every stage after track depends on it through tracks.yml; sfm and clone name
+    // it too (the frame shift of the cameras, the key frames left out).
+    const String framesOption = cv::format("%d:%d", first, end);
+    mTrack.option("frames", framesOption);
     const bool trackReused = !o.force && detail::manifestMatches(mTrack, tracksPath);
     bool tracksLoaded = false;
     auto loadTracks = [&]() {
@@ -368,14 +426,17 @@ RunResult runPipeline(const RunOptions& o)
         detail::removeManifest(tracksPath);
         FeatureTracker::Params tp;
         tp.progress = o.progress;
-        FeatureTracker::create(tp)->track(src, r.tracks);
+        Tracks local;
+        FeatureTracker::create(tp)->track(makePtr<FrameRangeSource>(src, first, end), local);
         tracksLoaded = true;
         // A video cut short or corrupt mid-stream ends early: found here, before anything is
         // written, not later as cameras missing for the masks' frames.
-        if (r.tracks.frames() != frameCount)
+        if (local.frames() != end - first)
             CV_Error(Error::StsParseError, o.input + cv::format(": %d frames decoded of the %d "
-                     "the input declares (cut short or corrupt)", r.tracks.frames(),
+                     "the input declares (cut short or corrupt)", first + local.frames(),
                      frameCount));
+        // Input frame numbers (the contract): frames before `first` are empty.
+        r.tracks = first > 0 ? local.shiftedFrames(first, end) : local;
         writeTracks(tracksPath, r.tracks);
         detail::writeManifest(mTrack, tracksPath);
     }
@@ -388,6 +449,7 @@ RunResult runPipeline(const RunOptions& o)
     mSfm.option("focal", o.focal);
     mSfm.option("refine_intrinsics", o.refineIntrinsics ? "1" : "0");
     mSfm.option("self_calibrate", o.selfCalibrate ? "1" : "0");
+    mSfm.option("frames", framesOption);
     timer.start();
     if (!o.force && detail::manifestMatches(mSfm, recPath))
     {
@@ -415,6 +477,7 @@ RunResult runPipeline(const RunOptions& o)
     mClone.option("voxel_pixels", o.voxelPixels);
     mClone.option("free_space", o.freeSpace ? "1" : "0");
     mClone.option("photo_refine", o.photoRefine ? "1" : "0");
+    mClone.option("frames", framesOption);
     timer.start();
     if (!o.force && detail::manifestMatches(mClone, clonesPath))
     {
@@ -429,9 +492,9 @@ RunResult runPipeline(const RunOptions& o)
         if (o.photoRefine)
         {
             // Every frame with a camera (the others stay empty; refine() reads only those).
-            std::vector<Mat> frames(frameCount);
-            src->seek(0);
-            for (int f = 0; f < frameCount; f++)
+            std::vector<Mat> frames(end);
+            src->seek(first);
+            for (int f = first; f < end; f++)
             {
                 Mat img;
                 if (!src->read(img))

@@ -468,15 +468,28 @@ public:
         if (canvas.size() != image_.size())
             CV_Error(Error::StsBadSize, "SilhouetteEditor::drawOverlay: canvas size differs "
                                         "from the image size");
-        Mat fill = Mat::zeros(canvas.size(), CV_8U);
+        // The tint is blended inside the closed contours' bounding box only (a 4K frame is
+        // 25 MB; the silhouettes cover a part of it).
+        std::vector<std::vector<Point>> closedLines;
+        Rect box;
         for (const ContourData& c : state_)
             if (c.closed)
-                fillPoly(fill, std::vector<std::vector<Point>>(1, contourPolyline(c)),
-                         Scalar::all(255), LINE_8);
-        Mat tint(canvas.size(), CV_8UC3, Scalar(0, 200, 0));
-        Mat blended;
-        addWeighted(canvas, 0.65, tint, 0.35, 0, blended);
-        blended.copyTo(canvas, fill);
+            {
+                closedLines.push_back(contourPolyline(c));
+                box |= boundingRect(closedLines.back());
+            }
+        box &= Rect(Point(), canvas.size());
+        if (!box.empty())
+        {
+            Mat fill = Mat::zeros(box.size(), CV_8U);
+            for (const std::vector<Point>& l : closedLines)
+                fillPoly(fill, std::vector<std::vector<Point>>(1, l), Scalar::all(255), LINE_8,
+                         0, -box.tl());
+            Mat roi = canvas(box), blended;
+            addWeighted(roi, 0.65, Mat(box.size(), CV_8UC3, Scalar(0, 200, 0)), 0.35, 0,
+                        blended);
+            blended.copyTo(roi, fill);
+        }
         for (const ContourData& c : state_)
         {
             const Scalar closedLive(0, 255, 255), closedStraight(255, 160, 0);

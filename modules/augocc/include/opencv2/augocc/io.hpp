@@ -86,6 +86,14 @@ struct CV_EXPORTS Tracks
     `fn` must be thread-safe); observations mapped to a non-finite position are dropped. */
     Tracks mapped(const std::function<Point2f(int, int, const Point2f&)>& fn,
                   Size newImageSize) const;
+    /** @brief The same tracks with every frame number moved by `offset`, in a sequence of
+    `frames` frames: the tracks of a sub-range of a shot (`augocc run --frames a:b`) in the
+    input's frame numbers (offset a) and back (offset -a). Observations, their order and the
+    track numbers are kept. Throws StsOutOfRange when an observation's frame leaves
+    [0, frames). */
+    Tracks shiftedFrames(int offset, int frames) const;
+    //! The first frame with an observation (frames() when there is none).
+    int firstObservedFrame() const;
     /** @brief The dense block of the given frames (rows) and points (columns), CV_32FC2, NaN
     where unobserved; empty lists = every frame / every point. For small blocks only (tests,
     displays): the whole shot's block is F x P. */

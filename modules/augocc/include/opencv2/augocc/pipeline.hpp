@@ -82,6 +82,14 @@ struct CV_EXPORTS RunOptions
     String masksDir;         //!< key-frame masks, `MASKS/<object>/%04d.png`
     String scenePath;        //!< scene.yml; empty: stop after the mattes
     String outDir;           //!< every intermediate file and the composite go here
+    /** Frames processed: [firstFrame, endFrame) of the input (`augocc run --frames a:b`, half-
+    open), at least three (camera recovery needs three views). Every output keeps the input's
+    frame numbers (tracks.yml has endFrame frames, the first firstFrame of them empty; cameras,
+    `mattes/<object>/%04d.png` and the composite cover firstFrame..endFrame-1). Key-frame masks
+    outside the range are ignored (RunResult::ignoredMasks); an object with none inside it is
+    an error. */
+    int firstFrame = 0;
+    int endFrame = -1;       //!< one past the last frame processed; -1: the input's end
     //! Compositor::Params::supersample (1: hard edges)
     int supersample = Compositor::Params().supersample;
     //! Compositor::Params::antialiasVirtual
@@ -124,6 +132,9 @@ struct CV_EXPORTS RunResult
     //! stageSeconds are the reading. `tracks` stays empty when no stage run needed it, `sfm`
     //! when sfm was reused.
     std::vector<String> reused;
+    //! Key-frame mask files left out because their frame is outside the frames processed
+    //! (RunOptions::firstFrame, endFrame).
+    std::vector<String> ignoredMasks;
 };
 
 /** @brief track -> sfm -> clone -> matte -> composite, writing into outDir: tracks.yml,
