@@ -7,6 +7,9 @@
 #   scripts/fuzz.sh SECONDS [NAME...]
 #                              run each fuzzer (or the NAMEd ones) for SECONDS at nice 19 and print
 #                              executions, executions per second and coverage
+#   scripts/fuzz.sh --runs N [NAME...]
+#                              run each fuzzer for N executions (issue 17's campaign: 1000000),
+#                              capped at 30 minutes each
 #
 # Needs the main build (scripts/build.sh) for libopencv_augocc.so. Findings are written to
 # build-fuzz/findings/<name>/ (crash-*, timeout-*, oom-*); the corpus grows in build-fuzz/corpus/.
@@ -26,8 +29,15 @@ if [ $# -eq 0 ]; then
     ctest --test-dir build-fuzz --output-on-failure -j2 -L 'fuzz|sanitize'
     exit
 fi
-SECONDS_EACH=$1
-shift
+LIMIT=()
+if [ "$1" = "--runs" ]; then
+    [ $# -ge 2 ] || { echo "fuzz: --runs needs a count" >&2; exit 2; }
+    LIMIT=(-runs="$2" -max_total_time=1800)
+    shift 2
+else
+    LIMIT=(-max_total_time="$1")
+    shift
+fi
 NAMES=("$@")
 [ ${#NAMES[@]} -gt 0 ] || NAMES=(tracks reconstruction calibration clones scene mesh masks)
 printf '%-15s %12s %10s %8s %8s %s\n' fuzzer executions execs/s cov ft findings
@@ -36,7 +46,7 @@ for n in "${NAMES[@]}"; do
     mkdir -p "build-fuzz/corpus/$n" "build-fuzz/findings/$n"
     log="build-fuzz/findings/$n/run.log"
     set +e
-    nice -n 19 "build-fuzz/bin/fuzz_$n" -max_total_time="$SECONDS_EACH" -timeout=10 \
+    nice -n 19 "build-fuzz/bin/fuzz_$n" "${LIMIT[@]}" -timeout=10 \
         -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="build-fuzz/findings/$n/" \
         "build-fuzz/corpus/$n" "fuzz/corpus/$n" >"$log" 2>&1
     rc=$?

@@ -23,7 +23,7 @@ PACKAGES=(
     slurm-wlm munge                       # augocc farm's test: a single-node Slurm cluster
     shellcheck                            # the farm's generated job scripts are checked with it
     clang libclang-rt-14-dev              # libFuzzer + ASan/UBSan runtimes of the fuzz tree (fuzz/, scripts/fuzz.sh)
-    blender                               # Blender 3.4: test of augocc export-blender (blender -b, headless)
+    blender                               # Blender 3.4: tests of augocc export-blender (blender -b; its UI under xvfb)
 )
 
 missing=()

@@ -8,6 +8,7 @@
 
 #include "test_precomp.hpp"
 #include "test_silhouette_scene.hpp"
+#include "test_x11.hpp"
 
 #include <chrono>
 #include <csignal>
@@ -37,146 +38,7 @@ const double kMinProposedIoU = 0.95;
 const double kStartTimeoutS = 40.0;
 const double kExitTimeoutS = 30.0;
 
-bool haveTool(const std::string& name)
-{
-    return runCommand("command -v " + name + " >/dev/null") == 0;
-}
-
-// A child process killed (TERM, then KILL) when the guard goes out of scope.
-struct Child
-{
-    pid_t pid = -1;
-    ~Child() { stop(); }
-    void stop()
-    {
-        if (pid <= 0)
-            return;
-        ::kill(pid, SIGTERM);
-        for (int i = 0; i < 50; ++i)
-        {
-            if (::waitpid(pid, nullptr, WNOHANG) == pid)
-            {
-                pid = -1;
-                return;
-            }
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        }
-        ::kill(pid, SIGKILL);
-        ::waitpid(pid, nullptr, 0);
-        pid = -1;
-    }
-    // Exit status, or -1 on timeout or abnormal end.
-    int wait(double timeoutS)
-    {
-        const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeoutS);
-        while (std::chrono::steady_clock::now() < end)
-        {
-            int status = 0;
-            if (::waitpid(pid, &status, WNOHANG) == pid)
-            {
-                pid = -1;
-                return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-            }
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        }
-        return -1;
-    }
-};
-
-// Starts argv with extra environment, stdout+stderr into logPath.
-pid_t spawn(const std::vector<std::string>& argv, const std::vector<std::string>& env,
-            const std::string& logPath)
-{
-    const pid_t pid = ::fork();
-    if (pid != 0)
-        return pid;
-    const int fd = ::open(logPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0)
-    {
-        ::dup2(fd, 1);
-        ::dup2(fd, 2);
-        ::close(fd);
-    }
-    for (const std::string& e : env)
-        ::putenv(::strdup(e.c_str()));
-    std::vector<char*> args;
-    for (const std::string& a : argv)
-        args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    ::execvp(args[0], args.data());
-    ::_exit(127);
-}
-
-// A display number nobody uses: from the pid, skipping numbers with a lock or socket.
-int freeDisplay()
-{
-    for (int i = 0; i < 400; ++i)
-    {
-        const int n = 100 + (int(::getpid()) + i) % 400;
-        if (!fs::exists(format("/tmp/.X%d-lock", n)) && !fs::exists(format("/tmp/.X11-unix/X%d", n)))
-            return n;
-    }
-    return -1;
-}
-
-std::string readFile(const std::string& path)
-{
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-void sleepMs(int ms)
-{
-    std::this_thread::sleep_for(std::chrono::milliseconds(ms));
-}
-
-class Xdo
-{
-public:
-    explicit Xdo(const std::string& display) : display_(display) {}
-    void run(const std::string& args)
-    {
-        std::string out;
-        const int rc = runCommand("DISPLAY=" + display_ + " timeout 10 xdotool " + args, &out);
-        EXPECT_EQ(0, rc) << "xdotool " << args << ": " << out;
-    }
-    // --sync waits for the pointer to move, so it is not used for the position it is at.
-    void moveTo(Point screen)
-    {
-        if (screen == pointer_)
-            return;
-        run(format("mousemove --sync %d %d", screen.x, screen.y));
-        pointer_ = screen;
-        sleepMs(60);
-    }
-    void click(Point screen)
-    {
-        moveTo(screen);
-        run("click 1");
-        sleepMs(250);  // one live-wire segment plus a redraw
-    }
-    void key(const std::string& k)
-    {
-        run("key " + k);
-        sleepMs(250);
-    }
-
-private:
-    std::string display_;
-    Point pointer_ = Point(-1, -1);
-};
-
-void grab(const std::string& display, const Rect& r, const std::string& path)
-{
-    std::string out;
-    const int rc = runCommand(format("timeout 20 ffmpeg -loglevel error -y -f x11grab "
-                                     "-video_size %dx%d -i %s+%d,%d -frames:v 1 '%s'",
-                                     r.width, r.height, display.c_str(), r.x, r.y, path.c_str()),
-                              &out);
-    EXPECT_EQ(0, rc) << "ffmpeg x11grab: " << out;
-}
+using namespace x11;
 
 TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
 {

@@ -488,7 +488,7 @@ TEST_F(Augocc_CliComposite, export_blender_bad_input)
                                 c.frame, {-0.1, 0, 0, 0, 0, 0.01, 0, 0});
     writeReconstruction(in + "/rational.yml", persp);
     EXPECT_TRUE(badInputRejected(exportArgs(d.frames, in + "/rational.yml", d.scene, script),
-                                 {"rational.yml", "frame 0", "coefficient 5"}, out_));
+                                 {"rational.yml", "frame 0", "coefficient k4"}, out_));
 }
 
 } // namespace

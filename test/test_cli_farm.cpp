@@ -34,6 +34,21 @@ TEST(Augocc_Farm, split_frames)
     EXPECT_EQ(chunkDir({12, 16}), "chunks/0012-0016");
 }
 
+// readShotsFile's message for a shots file `file` holding `text` ("no error" when it reads).
+std::string shotsError(const fs::path& file, const std::string& text)
+{
+    std::ofstream(file) << text;
+    try
+    {
+        readShotsFile(file.string());
+    }
+    catch (const UsageError& e)
+    {
+        return std::string(e.what());
+    }
+    return std::string("no error");
+}
+
 TEST(Augocc_Farm, shots_file)
 {
     const fs::path dir = tempDir("farm_shots");
@@ -61,24 +76,53 @@ TEST(Augocc_Farm, shots_file)
     EXPECT_EQ(s[1].scene, "");
     EXPECT_EQ(s[1].name, "shot.b");
 
-    auto errorOf = [&](const std::string& text) {
-        std::ofstream(file) << text;
-        try
-        {
-            readShotsFile(file.string());
-        }
-        catch (const UsageError& e)
-        {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
+    auto errorOf = [&](const std::string& text) { return shotsError(file, text); };
     const std::string where = file.string() + ":2: ";
     EXPECT_EQ(errorOf("# nothing\n"), "--shots " + file.string() +
               ": no shot (a line 'input masks scene out-dir')");
     EXPECT_EQ(errorOf("a b c d\na b c\n").rfind(where + "expected 4 fields", 0), 0u);
     EXPECT_EQ(errorOf("a b c x/shot\na b c y/shot\n").rfind(where + "out-dir", 0), 0u);
     EXPECT_EQ(errorOf("a b c x/sh%ot\n").rfind(file.string() + ":1: out-dir", 0), 0u);
+    fs::remove_all(dir);
+}
+
+TEST(Augocc_Farm, shots_file_yaml)
+{
+    // The same shots as a YAML (or JSON) list of maps; scene optional.
+    const fs::path dir = tempDir("farm_shots_yaml");
+    const fs::path file = dir / "shots.yml";
+    std::ofstream(file) << "%YAML:1.0\n---\nshots:\n"
+                        << "  - { input: a/video.mp4, masks: a/masks, scene: a/scene.yml, "
+                           "out_dir: out/shot_a }\n"
+                        << "  - { input: \"/abs/b/%04d.png\", masks: /abs/b/masks, "
+                           "out_dir: /abs/out/shot.b }\n";
+    const std::vector<Shot> s = readShotsFile(file.string());
+    ASSERT_EQ(s.size(), 2u);
+    EXPECT_EQ(s[0].input, (dir / "a/video.mp4").string());
+    EXPECT_EQ(s[0].scene, (dir / "a/scene.yml").string());
+    EXPECT_EQ(s[0].name, "shot_a");
+    EXPECT_EQ(s[1].input, "/abs/b/%04d.png");
+    EXPECT_EQ(s[1].scene, "");
+    EXPECT_EQ(s[1].name, "shot.b");
+    const fs::path json = dir / "shots.json";
+    std::ofstream(json) << "{ \"shots\": [ { \"input\": \"v.mp4\", \"masks\": \"m\", "
+                           "\"out_dir\": \"o/x\" } ] }\n";
+    ASSERT_EQ(readShotsFile(json.string()).size(), 1u);
+
+    auto errorOf = [&](const std::string& text) { return shotsError(file, text); };
+    const std::string f = file.string();
+    EXPECT_EQ(errorOf("%YAML:1.0\n---\nshots: []\n").rfind("--shots " + f + ": no shot", 0), 0u);
+    EXPECT_EQ(errorOf("%YAML:1.0\n---\nshots:\n  - { input: v, out_dir: o/x }\n"),
+              f + ": shot 1: key 'masks' is missing");
+    EXPECT_EQ(errorOf("%YAML:1.0\n---\nshots:\n  - { input: v, masks: m, out: o/x }\n"),
+              f + ": shot 1: unknown key 'out' (input, masks, scene, out_dir)");
+    EXPECT_EQ(errorOf("%YAML:1.0\n---\nshots:\n  - { input: v, masks: m, out_dir: x/s }\n"
+                      "  - { input: w, masks: m, out_dir: y/s }\n")
+                  .rfind(f + ": shot 2: out-dir", 0),
+              0u);
+    // A file the parsers would crash on is refused before them (the readers' limits).
+    EXPECT_EQ(errorOf("<?xml version=").find("no shot"), std::string::npos);
+    EXPECT_NE(errorOf("%YAML:1.0\nshots: [ { input: v\n").find("--shots " + f), std::string::npos);
     fs::remove_all(dir);
 }
 

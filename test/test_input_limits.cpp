@@ -163,10 +163,54 @@ TEST(Augocc_InputLimits, regression_fuzz_nul_byte_and_top_level)
     const std::string marker = dataFile("fuzz_scene_marker_hang.yml");
     EXPECT_TRUE(throwsWith([&] { readScene(marker); },
                            {marker, "line 2", "'---' document marker"}));
+    // Found by fuzz_calibration: a "..." document end with text glued to it, or followed by a
+    // line starting with '-', made FileStorage::open loop for ever (the finding, and its cores).
+    const std::string end = dataFile("fuzz_calibration_document_end_hang.yml");
+    EXPECT_TRUE(throwsWith([&] { readCalibration(end); },
+                           {end, "line 5", "'...' document marker"}));
+    // The same in a clones file (fuzz_clones, the million-execution campaign: "...-bjects:").
+    const std::string clonesEnd = dataFile("fuzz_clones_document_end_hang.yml");
+    EXPECT_TRUE(throwsWith([&] { CloneSet::load(clonesEnd); },
+                           {clonesEnd, "line 6", "'...' document marker"}));
+    const std::string afterEnd = dir + "/after_end.yml";
+    writeText(afterEnd, "%YAML:1.0\n---\na: 6\n...\n-x\n");
+    for (const auto& read : storageReaders(afterEnd))
+        EXPECT_TRUE(throwsWith(read, {afterEnd, "line 5", "top-level key"}));
     const std::string core = dir + "/core.yml";
     writeText(core, "%YAML:1.0\n  - name: x\n-x--\n");
     for (const auto& read : storageReaders(core))
         EXPECT_TRUE(throwsWith(read, {core, "top-level key"}));
+    fs::remove_all(dir);
+}
+
+TEST(Augocc_InputLimits, regression_fuzz_xml_cut_short)
+{
+    // Found by fuzz_tracks: a file ending inside XML markup ("<?xml version=", the whole finding)
+    // made OpenCV 4.6's XML parser read past the text's end (SEGV in FileStorage::open).
+    const std::string f = dataFile("fuzz_tracks_xml_cut_segv.yml");
+    for (const auto& read : storageReaders(f))
+        EXPECT_TRUE(throwsWith(read, {f, "line 1", "processing instruction not closed"}));
+    // Each construct cut short, every reader: a clear error naming the line, no parse attempt.
+    const std::string dir = tempDir("limits_xml");
+    const std::pair<const char*, const char*> cuts[] = {
+        {"<?xml version=\"1.0\"?>\n<opencv_storage>\n<!-- a comment", "comment not closed"},
+        {"<?xml version=\"1.0\"?>\n<opencv_storage>\n<frames type_id=\"opencv", "quoted value"},
+        {"<?xml version=\"1.0\"?>\n<opencv_storage>\n<frames", "markup not closed"}};
+    for (const auto& c : cuts)
+    {
+        const std::string p = dir + "/cut.xml";
+        writeText(p, c.first);
+        for (const auto& read : storageReaders(p))
+            EXPECT_TRUE(throwsWith(read, {p, "line 3", c.second}));
+    }
+    // A complete XML file still reads (calibrateCamera users write XML calibration files).
+    const std::string ok = dir + "/calibration.xml";
+    writeText(ok, "<?xml version=\"1.0\"?>\n<opencv_storage>\n<camera_matrix type_id=\"opencv-matrix\">"
+                  "<rows>3</rows><cols>3</cols><dt>d</dt><data>500. 0. 320. 0. 500. 240. 0. 0. "
+                  "1.</data></camera_matrix>\n<distortion_coefficients type_id=\"opencv-matrix\">"
+                  "<rows>1</rows><cols>5</cols><dt>d</dt><data>0. 0. 0. 0. 0.</data>"
+                  "</distortion_coefficients>\n</opencv_storage>\n");
+    EXPECT_NO_THROW(readCalibration(ok));
     fs::remove_all(dir);
 }
 

@@ -374,5 +374,53 @@ TEST(Augocc_RunDriver, results_do_not_depend_on_progress)
     EXPECT_GT(heard["matte"], 0);
 }
 
+// Issue 17: a frame replaced while a stage reads it. Before, the tracks (a mixture of the two
+// versions) were kept and their manifest made the next run reuse them; now the stage's end finds
+// the input's sizes/times changed, keeps nothing and names the input.
+TEST(Augocc_RunDriver, regression_input_replaced_while_read)
+{
+    const RunData& d = runData();
+    ASSERT_TRUE(d.ok);
+    const String dir = tempDir("replaced");
+    const String frames = dir + "/frames";
+    fs::copy(d.frames, frames, fs::copy_options::recursive);
+    RunOptions o;
+    o.input = frames;
+    o.masksDir = d.masks;
+    o.outDir = dir + "/run";
+    o.photoRefine = false;
+    bool replaced = false;
+    o.progress = [&](const Progress& p) {
+        // Half-way through tracking: a new version of a frame still to be read (atomically,
+        // as an editor or a sync tool replaces it), slightly brighter: the second run below
+        // tracks it as well as the first.
+        if (replaced || p.stage != "track" || p.done < 6)
+            return;
+        Mat f = imread(frames + "/0010.png");
+        f += Scalar::all(2);
+        imwrite(frames + "/.new.png", f);
+        fs::rename(frames + "/.new.png", frames + "/0010.png");
+        replaced = true;
+    };
+    try
+    {
+        runPipeline(o);
+        ADD_FAILURE() << "a run over replaced frames succeeded";
+    }
+    catch (const cv::Exception& e)
+    {
+        EXPECT_NE(String::npos, e.err.find(frames + ": changed while the run read it")) << e.err;
+    }
+    EXPECT_TRUE(replaced) << "the track stage reported no progress to hook";
+    EXPECT_FALSE(fs::exists(o.outDir + "/tracks.yml"));
+    EXPECT_FALSE(fs::exists(o.outDir + "/tracks.manifest.yml"));
+    // Unchanged from here on, the same run goes through (the stages start afresh).
+    o.progress = ProgressCallback();
+    EXPECT_NO_THROW(runPipeline(o));
+    EXPECT_TRUE(fs::exists(o.outDir + "/mattes"));
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+}
+
 } // namespace
 } // namespace opencv_test

@@ -124,6 +124,7 @@ void registerExportBlender(CLI::App& app, Globals& g);
 void registerRun(CLI::App& app, Globals& g);
 void registerDemo(CLI::App& app, Globals& g);
 void registerAnnotate(CLI::App& app, Globals& g);
+void registerPlace(CLI::App& app, Globals& g);
 void registerPropagate(CLI::App& app, Globals& g);
 void registerJoin(CLI::App& app, Globals& g);
 void registerFarm(CLI::App& app, Globals& g);

@@ -206,15 +206,11 @@ void runFarm(const Globals& g, const FarmCliOptions& o)
     for (const Plan& p : plans)
     {
         const fs::path farmDir = fs::path(p.shot.outDir) / "farm";
-        fs::create_directories(farmDir / "logs");
-        for (const Script& s : makeScripts(p, w))
-        {
-            const std::string path = (farmDir / s.file).string();
-            farm::writeTextFile(path, s.text, true);
-            if (o.dryRun)
-                std::cout << "# ==> " << path << " <==\n" << s.text << "\n";
-        }
-        writePlan(p, w);
+        const std::vector<Script> scripts = makeScripts(p, w);
+        writeWorkflow(p, scripts, w);  // all or nothing
+        if (o.dryRun)
+            for (const Script& s : scripts)
+                std::cout << "# ==> " << (farmDir / s.file).string() << " <==\n" << s.text << "\n";
         submit(g, p, o.sbatch, o.dryRun);
     }
 }

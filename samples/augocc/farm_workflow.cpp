@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>
 #include <opencv2/augocc.hpp>
 
 namespace fs = std::filesystem;
@@ -111,12 +112,91 @@ std::string shotName(const std::string& outDir)
     return name.empty() ? std::string("shot") : name;
 }
 
+namespace {
+
+// One shot from its four fields (relative paths against `base`), checked against those before.
+void addShot(std::vector<Shot>& shots, const fs::path& base, const std::string& where,
+             const std::string& input, const std::string& masks, const std::string& scene,
+             const std::string& outDir)
+{
+    Shot s;
+    s.input = absoluteFrom(base, input);
+    s.masks = absoluteFrom(base, masks);
+    s.scene = scene.empty() || scene == "-" ? std::string() : absoluteFrom(base, scene);
+    s.outDir = absoluteFrom(base, outDir);
+    checkFarmPath(where + ": out-dir", s.outDir);
+    s.name = shotName(s.outDir);
+    for (const Shot& other : shots)
+        if (other.name == s.name)
+            throw UsageError(where + ": out-dir " + s.outDir + " has the folder name of " +
+                             other.outDir + " (job names come from it: make them differ)");
+    shots.push_back(s);
+}
+
+bool isStorageName(const std::string& path)
+{
+    std::string p = path;
+    if (p.size() > 3 && p.compare(p.size() - 3, 3, ".gz") == 0)
+        p.resize(p.size() - 3);
+    const std::string ext = fs::path(p).extension().string();
+    return ext == ".yml" || ext == ".yaml" || ext == ".json";
+}
+
+// shots: [{input, masks, scene (optional), out_dir}, ...] in YAML or JSON.
+std::vector<Shot> readShotsStorage(const std::string& path, const fs::path& base)
+{
+    std::vector<Shot> shots;
+    try
+    {
+        cv::FileStorage fsr = cv::augocc::openStorageForRead(path, "shots file");
+        const cv::FileNode list = fsr["shots"];
+        if (!list.isSeq() || list.size() == 0)
+            throw UsageError("--shots " + path + ": no shot (a sequence 'shots' of maps with "
+                             "input, masks, scene and out_dir)");
+        for (int i = 0; i < (int)list.size(); i++)
+        {
+            const cv::FileNode n = list[i];
+            const std::string where = path + cv::format(": shot %d", i + 1);
+            if (!n.isMap())
+                throw UsageError(where + ": expected a map with input, masks, scene, out_dir");
+            for (const cv::FileNode& k : n)
+                if (k.name() != "input" && k.name() != "masks" && k.name() != "scene" &&
+                    k.name() != "out_dir")
+                    throw UsageError(where + ": unknown key '" + k.name() +
+                                     "' (input, masks, scene, out_dir)");
+            auto text = [&](const char* key, bool required) {
+                const cv::FileNode v = n[key];
+                if (v.empty() || v.isNone())
+                {
+                    if (required)
+                        throw UsageError(where + ": key '" + key + "' is missing");
+                    return std::string();
+                }
+                if (!v.isString() || v.string().empty())
+                    throw UsageError(where + ": key '" + key + "' must be a non-empty path");
+                return v.string();
+            };
+            addShot(shots, base, where, text("input", true), text("masks", true),
+                    text("scene", false), text("out_dir", true));
+        }
+    }
+    catch (const cv::Exception& e)
+    {
+        throw UsageError("--shots " + e.err);
+    }
+    return shots;
+}
+
+} // namespace
+
 std::vector<Shot> readShotsFile(const std::string& path)
 {
+    const fs::path base = fs::absolute(fs::path(path)).parent_path();
+    if (isStorageName(path))
+        return readShotsStorage(path, base);
     std::ifstream in(path);
     if (!in)
         throw UsageError("--shots " + path + ": cannot be read");
-    const fs::path base = fs::absolute(fs::path(path)).parent_path();
     std::vector<Shot> shots;
     std::string line;
     for (int number = 1; std::getline(in, line); number++)
@@ -134,18 +214,7 @@ std::vector<Shot> readShotsFile(const std::string& path)
         if (w.size() != 4)
             throw UsageError(where + ": expected 4 fields, input masks scene out-dir ('-' for no "
                              "scene), found " + std::to_string(w.size()));
-        Shot s;
-        s.input = absoluteFrom(base, w[0]);
-        s.masks = absoluteFrom(base, w[1]);
-        s.scene = w[2] == "-" ? std::string() : absoluteFrom(base, w[2]);
-        s.outDir = absoluteFrom(base, w[3]);
-        checkFarmPath(where + ": out-dir", s.outDir);
-        s.name = shotName(s.outDir);
-        for (const Shot& other : shots)
-            if (other.name == s.name)
-                throw UsageError(where + ": out-dir " + s.outDir + " has the folder name of " +
-                                 other.outDir + " (job names come from it: make them differ)");
-        shots.push_back(s);
+        addShot(shots, base, where, w[0], w[1], w[2], w[3]);
     }
     if (shots.empty())
         throw UsageError("--shots " + path + ": no shot (a line 'input masks scene out-dir')");
@@ -348,9 +417,41 @@ std::vector<std::string> sbatchArgs(const Submission& s, const std::string& depe
     return a;
 }
 
-void writePlan(const Plan& plan, const Options& o)
+namespace {
+
+// `name` of farm/ written completely into `staging` (errors name its place in farmDir).
+void writeStaged(const fs::path& staging, const fs::path& farmDir, const std::string& name,
+                 const std::string& text, bool executable)
 {
-    const std::string path = (fs::path(plan.shot.outDir) / "farm" / "plan.yml").string();
+    const std::string shown = (farmDir / name).string();
+    try
+    {
+        cv::augocc::writeFileAtomically((staging / name).string(), text, executable);
+    }
+    catch (const cv::Exception& e)
+    {
+        // The staging folder is an implementation detail: name the file the user will see.
+        std::string msg = e.err;
+        const std::string tmp = (staging / name).string();
+        for (size_t at; (at = msg.find(tmp)) != std::string::npos;)
+            msg.replace(at, tmp.size(), shown);
+        CV_Error(cv::Error::StsError, msg);
+    }
+}
+
+void commitStaged(const fs::path& staging, const fs::path& farmDir, const std::string& name)
+{
+    std::error_code ec;
+    fs::rename(staging / name, farmDir / name, ec);
+    if (ec)
+        CV_Error(cv::Error::StsError,
+                 (farmDir / name).string() + ": cannot be written: " + ec.message());
+}
+
+} // namespace
+
+std::string planText(const Plan& plan, const Options& o)
+{
     cv::FileStorage fsw(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     fsw << "description" << "augocc farm: the shot's workflow (augocc farm resume reads it)";
     fsw << "name" << plan.shot.name << "input" << plan.shot.input << "masks" << plan.shot.masks
@@ -366,12 +467,51 @@ void writePlan(const Plan& plan, const Options& o)
     for (const std::string& l : o.setup)
         fsw << l;
     fsw << "]";
-    writeTextFile(path, fsw.releaseAndGetString());
+    return fsw.releaseAndGetString();
 }
 
-void writeTextFile(const std::string& path, const std::string& text, bool executable)
+void writePlan(const Plan& plan, const Options& o)
 {
-    cv::augocc::writeFileAtomically(path, text, executable);  // every write checked
+    writeWorkflow(plan, {}, o);
+}
+
+void writeWorkflow(const Plan& plan, const std::vector<Script>& scripts, const Options& o)
+{
+    const fs::path outDir(plan.shot.outDir), farmDir = outDir / "farm";
+    // Folders made here go again on failure: the outermost one that did not exist.
+    fs::path made;
+    for (fs::path d = farmDir / "logs"; !d.empty() && !fs::exists(d); d = d.parent_path())
+        made = d;
+    // Every file is written into a staging folder first; only when all are complete are they
+    // renamed into farm/ (renames need no space): a full disk leaves the workflow as it was.
+    const fs::path staging = outDir / cv::format(".farm.tmp%d", (int)getpid());
+    std::error_code ec;
+    try
+    {
+        fs::create_directories(farmDir / "logs", ec);
+        if (ec)
+            CV_Error(cv::Error::StsError,
+                     (farmDir / "logs").string() + ": cannot create folder: " + ec.message());
+        fs::remove_all(staging, ec);
+        fs::create_directory(staging, ec);
+        if (ec)
+            CV_Error(cv::Error::StsError,
+                     farmDir.string() + ": cannot create its staging folder: " + ec.message());
+        for (const Script& s : scripts)
+            writeStaged(staging, farmDir, s.file, s.text, true);
+        writeStaged(staging, farmDir, "plan.yml", planText(plan, o), false);
+        for (const Script& s : scripts)
+            commitStaged(staging, farmDir, s.file);
+        commitStaged(staging, farmDir, "plan.yml");
+        fs::remove_all(staging, ec);
+    }
+    catch (...)
+    {
+        fs::remove_all(staging, ec);
+        if (!made.empty())
+            fs::remove_all(made, ec);
+        throw;
+    }
 }
 
 void readPlan(const std::string& outDir, Plan& plan, Options& o)

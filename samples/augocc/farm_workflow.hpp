@@ -111,10 +111,14 @@ std::vector<std::string> sbatchArgs(const Submission& s, const std::string& depe
 std::string arraySpec(const std::vector<int>& tasks);
 
 //! Writes / reads outDir/farm/plan.yml (what resume needs; cv::FileStorage YAML).
-/** Writes `text` to `path` all or nothing (writeAtomically), mode 0755 when `executable`;
-cv::Exception naming the path when it cannot. */
-void writeTextFile(const std::string& path, const std::string& text, bool executable = false);
-
+//! plan.yml's text: what `augocc farm resume` reads back (readPlan).
+std::string planText(const Plan& plan, const Options& options);
+/** @brief Writes outDir/farm/: the scripts (mode 0755) and plan.yml, all or nothing: each is
+written completely into a staging folder and only then renamed into place, so a full disk or an
+unwritable folder is a cv::Exception naming the file with nothing new left behind (folders made
+for it removed again); logs/ is made for the jobs. */
+void writeWorkflow(const Plan& plan, const std::vector<Script>& scripts, const Options& options);
+//! writeWorkflow() with no scripts: plan.yml alone.
 void writePlan(const Plan& plan, const Options& options);
 void readPlan(const std::string& outDir, Plan& plan, Options& options);
 

@@ -16,19 +16,24 @@ if ! command -v "$BLENDER" >/dev/null; then
     exit 77
 fi
 T=$(mktemp -d /tmp/augocc_blender.XXXXXX)
-trap 'rm -rf "$T"' EXIT
+[ -n "${AUGOCC_BLENDER_KEEP:-}" ] || trap 'rm -rf "$T"' EXIT
 MIN_IOU=0.98
 MAX_CENTROID_PX=0.5
+# The lens case: OpenCV's k1, k2, p1, p2, k3, exported as the movie clip's BROWN model (tangential
+# terms) and applied by the shot's Movie Distortion node.
+LENS=${AUGOCC_BLENDER_LENS:--0.2,0.05,0.004,-0.003,0}
 
 printf '%s\n' '%YAML:1.0' '---' 'objects:' \
     '  - { name: dome, shape: dome, behind: building, distance: 0.05, size: 0.6, offset: [-0.45, 0, 0] }' \
     '  - { name: tree, shape: tree, in_front_of: building, distance: 0.15, size: 0.6, offset: [-0.2, 0, 0] }' \
     >"$T/scene.yml"
 status=0
-for model in scaled_orthographic perspective; do
-    D=$T/$model
+for case in scaled_orthographic perspective lens; do
+    D=$T/$case
+    model=$case
     extra=()
-    [ "$model" = perspective ] && extra=(--distance-ratio 3)
+    [ "$case" != scaled_orthographic ] && model=perspective && extra=(--distance-ratio 3)
+    [ "$case" = lens ] && extra+=(--distortion "$LENS")
     "$AUGOCC" --quiet synth --out "$D/src" --model "$model" --frames 12 --key-frames 3 \
         --size 320x240 "${extra[@]}"
     "$AUGOCC" --quiet clone --reconstruction "$D/src/gt/reconstruction.yml" \
@@ -39,7 +44,7 @@ for model in scaled_orthographic perspective; do
     "$AUGOCC" --quiet export-blender --input "$D/src/frames" \
         --reconstruction "$D/src/gt/reconstruction.yml" --clones "$D/clones.yml.gz" \
         --scene "$T/scene.yml" --frames 2:5 --out "$D/shot/shot.py"
-    echo "== $model"
+    echo "== $case"
     if ! "$BLENDER" -b --factory-startup --python-exit-code 1 -P "$D/shot/shot.py" \
         -P "$HERE/render_compare.py" -- "$D/layer" "$D/render" "$MIN_IOU" "$MAX_CENTROID_PX" \
         2 3 4 >"$D/blender.log" 2>&1; then

@@ -23,7 +23,21 @@ scene.cycles.samples = 4
 scene.cycles.filter_width = 0.01
 scene.cycles.use_denoising = False
 scene.cycles.max_bounces = 0
-scene.render.use_compositing = False
+# The shot's compositor puts the footage behind the render (alpha 1 everywhere): keep only its
+# Movie Distortion node, when the shot has a lens, so that the render is checked through the
+# movie clip's distortion model as the shot applies it (augocc's layer is drawn through the lens).
+tree = scene.node_tree if scene.use_nodes else None
+distortion = [n for n in tree.nodes if n.bl_idname == 'CompositorNodeMovieDistortion'] \
+    if tree else []
+if distortion:
+    out = next(n for n in tree.nodes if n.bl_idname == 'CompositorNodeComposite')
+    out.use_alpha = True
+    tree.links.new(distortion[0].outputs['Image'], out.inputs['Image'])
+    scene.render.use_compositing = True
+    print('blender_compare: through the movie clip\'s %s lens model (Movie Distortion node)'
+          % distortion[0].clip.tracking.camera.distortion_model)
+else:
+    scene.render.use_compositing = False
 scene.render.image_settings.file_format = 'PNG'
 scene.render.image_settings.color_mode = 'RGBA'
 # The shadow catcher's shadows are alpha too; augocc's composite draws no shadow.

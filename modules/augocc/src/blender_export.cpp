@@ -101,29 +101,38 @@ String footageFile(const String& input)
     CV_Error(Error::StsObjectNotFound, input + ": no first frame (index 0 or 1) of the pattern");
 }
 
-// Lens distortion for Blender's tracking camera: POLYNOMIAL (k1, k2, k3) without tangential
-// terms, else BROWN (libmv's Brown model is OpenCV's k1, k2, p1, p2, k3). Blender's clip
-// coordinates have y up: with y' = -y both tangential equations keep their form when p1 changes
-// sign (p1 -> -p1, p2 unchanged; doc/blender.md). cx, cy stay OpenCV's (the script converts).
-String distortionJson(const Camera& c, const String& what)
+// Lens distortion for Blender's movie clip (its tracking camera), as the compositor's Movie
+// Distortion node and the undistorted camera background apply it (checked by a render,
+// doc/blender.md). They work in the clip's pixels with pixel centres at integers (OpenCV's rule)
+// and rows counted from the bottom, so the principal point is (cx, H - 1 - cy) and the
+// normalised y is OpenCV's -y: the tangential terms keep their form with p1 -> -p1. The models:
+// POLYNOMIAL (k1, k2, k3) without tangential terms, else BROWN, whose tangential terms are
+// OpenCV's with p1 and p2 swapped (libmv's ApplyBrownDistortionModel: x gets p1 (r^2 + 2 x^2),
+// OpenCV's x gets p2 (r^2 + 2 x^2)): brown_p1 = p2, brown_p2 = -p1. OpenCV's k4..k6 (rational),
+// s1..s4 (thin prism) and tau (tilt) have no Blender model: an error.
+String distortionJson(const Camera& c, int height, const String& what)
 {
     if (!c.hasDistortion())
         return "null";
     double d[14] = {0};
     for (size_t i = 0; i < c.distortion.size(); i++)
         d[i] = c.distortion[i];
+    static const char* const names[14] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6",
+                                          "s1", "s2", "s3", "s4", "tau_x", "tau_y"};
     for (int i = 5; i < 14; i++)
         if (d[i] != 0)
-            CV_Error(Error::StsNotImplemented, what + format(": frame %d: distortion coefficient "
-                     "%d is not 0; Blender's lens models have only k1, k2, k3, p1, p2", c.frame,
-                     i));
+            CV_Error(Error::StsNotImplemented, what + format(": frame %d: distortion "
+                     "coefficient %s = %g is not 0; Blender's lens models have only OpenCV's k1, "
+                     "k2, p1, p2, k3 (rational, thin prism and tilt terms cannot be exported)",
+                     c.frame, names[i], d[i]));
     const bool tangential = d[2] != 0 || d[3] != 0;
     const Point2d pp = c.principalPoint();
     std::ostringstream s;
-    s << "{\"model\": " << (tangential ? "\"BROWN\"" : "\"POLYNOMIAL\"") << ", \"k1\": " << num(d[0])
-      << ", \"k2\": " << num(d[1]) << ", \"k3\": " << num(d[4]) << ", \"p1\": " << num(-d[2])
-      << ", \"p2\": " << num(d[3]) << ", \"focal_px\": " << num(c.K(0, 0))
-      << ", \"cx\": " << num(pp.x) << ", \"cy\": " << num(pp.y) << "}";
+    s << "{\"model\": " << (tangential ? "\"BROWN\"" : "\"POLYNOMIAL\"")
+      << ", \"k1\": " << num(d[0]) << ", \"k2\": " << num(d[1]) << ", \"k3\": " << num(d[4])
+      << ", \"brown_p1\": " << num(d[3]) << ", \"brown_p2\": " << num(-d[2])
+      << ", \"focal_px\": " << num(c.K(0, 0))
+      << ", \"principal_px\": [" << num(pp.x) << ", " << num(height - 1 - pp.y) << "]}";
     return s.str();
 }
 
@@ -190,7 +199,7 @@ ShotData checkShot(const Reconstruction& rec, const BlenderShotOptions& o)
                      "are in the shot)", f, d.first, d.end));
     const Camera& c0 = rec.camera(d.first);
     for (int f = d.first; f < d.end; f++)
-        distortionJson(rec.camera(f), recName);  // throws on a model Blender lacks
+        distortionJson(rec.camera(f), rec.imageSize.height, recName);  // throws: no model
     if (rec.model == PERSPECTIVE)
         for (int f = d.first; f < d.end; f++)
         {
@@ -206,11 +215,18 @@ ShotData checkShot(const Reconstruction& rec, const BlenderShotOptions& o)
     return d;
 }
 
-} // namespace
+// What writeShot() has made so far, for writeBlenderShot() to remove on failure.
+struct ShotFiles
+{
+    String assetsTmp;  // the assets' temporary folder, until it is renamed into place
+    String script;     // the script, once written (before the assets are in place)
+    bool writing = false;  // the inputs were checked, files are being written
+};
 
-void writeBlenderShot(const String& scriptPath, const Reconstruction& rec,
-                      const CloneSet& clones, const VirtualScene& scene,
-                      const BlenderShotOptions& options)
+// writeBlenderShot() without the clean-up. All or nothing: the assets go to a temporary
+// folder, the script is written (atomically), and only then the folder is renamed into place.
+void writeShot(const String& scriptPath, const Reconstruction& rec, const CloneSet& clones,
+               const VirtualScene& scene, const BlenderShotOptions& options, ShotFiles& files)
 {
     if (scriptPath.empty())
         CV_Error(Error::StsBadArg, "no script path given");
@@ -230,8 +246,14 @@ void writeBlenderShot(const String& scriptPath, const Reconstruction& rec,
     const std::vector<String> objects = clones.objectNames();
     for (const String& o : objects)
         gridCorners(clones, o, corners);
+    // The assets, then the script, then the assets renamed into place (the caller removes what
+    // was made if anything fails).
+    files.writing = true;
+    detail::sweepStaleTemporaries(assets.string());
+    const String tmp = detail::tmpNameFor(assets.string());
+    files.assetsTmp = tmp;
     std::ostringstream objectsJson;
-    writeAtomically(assets.string(), [&](const String& tmp) {
+    {
         detail::createDirectories(tmp, assets.string());
         clones.exportPly((fs::path(tmp) / "clones").string());
         detail::createDirectories((fs::path(tmp) / "objects").string(), assets.string());
@@ -257,7 +279,7 @@ void writeBlenderShot(const String& scriptPath, const Reconstruction& rec,
                             << ", \"color\": " << vec(col.val, 3) << "}";
             }
         objectsJson << "]";
-    });
+    }
 
     // Clones: the trimmed model, and each key frame's patches with the frames that show them.
     std::ostringstream clonesJson;
@@ -373,10 +395,12 @@ void writeBlenderShot(const String& scriptPath, const Reconstruction& rec,
       << ",\n\"clip_start\": " << num(1e-3 * radius)
       << ",\n\"clip_end\": " << num(2 * clipEnd + radius)
       << ",\n\"samples\": " << options.samples
+      << ",\n\"script\": " << quoted(script.filename().string())
+      << ",\n\"assets\": " << quoted(assetsName)
       << ",\n\"footage\": "
       << (options.footage.empty() ? String("null")
                                   : quoted(relativeTo(footageFile(options.footage), here)))
-      << ",\n\"distortion\": " << distortionJson(rec.camera(shot.first),
+      << ",\n\"distortion\": " << distortionJson(rec.camera(shot.first), H,
                                                  options.reconstructionName)
       << ",\n\"blend\": "
       << (options.blendPath.empty() ? String("null")
@@ -392,9 +416,42 @@ void writeBlenderShot(const String& scriptPath, const Reconstruction& rec,
        << "tab, Run Script)\n"
        << "SHOT_JSON = r'''\n" << j.str() << "\n'''\n" << kBlenderShotPy;
     const String text = py.str();
-    writeAtomically(script.string(), [&](const String& tmp) {
-        detail::writeFileBytes(tmp, text.data(), text.size(), scriptPath);
+    writeAtomically(scriptPath, [&](const String& tmpScript) {
+        detail::writeFileBytes(tmpScript, text.data(), text.size(), scriptPath);
     });
+    files.script = scriptPath;
+    detail::commitTemporary(tmp, assets.string());
+    files.assetsTmp.clear();
+}
+
+} // namespace
+
+void writeBlenderShot(const String& scriptPath, const Reconstruction& rec,
+                      const CloneSet& clones, const VirtualScene& scene,
+                      const BlenderShotOptions& options)
+{
+    ShotFiles files;
+    try
+    {
+        writeShot(scriptPath, rec, clones, scene, options, files);
+    }
+    catch (const std::exception& e)
+    {
+        std::error_code ec;
+        if (!files.assetsTmp.empty())
+            fs::remove_all(files.assetsTmp, ec);
+        if (!files.script.empty())
+            fs::remove(files.script, ec);
+        const cv::Exception* cve = dynamic_cast<const cv::Exception*>(&e);
+        const fs::filesystem_error* fse = dynamic_cast<const fs::filesystem_error*>(&e);
+        const String what = cve ? cve->err
+                          : fse ? fse->path1().string() + ": " + fse->code().message()
+                                : String(e.what());
+        // A write failure names the script (the output the user asked for) first.
+        if (!files.writing || what.compare(0, scriptPath.size(), scriptPath) == 0)
+            throw;
+        CV_Error(cve ? cve->code : Error::StsError, scriptPath + ": " + what);
+    }
 }
 
 } // namespace augocc

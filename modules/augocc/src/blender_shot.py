@@ -24,7 +24,32 @@ import mathutils
 import numpy as np
 
 SHOT = json.loads(SHOT_JSON)
-HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def script_folder():
+    """The folder this script was written to, which holds its assets folder, however Blender
+    runs it. `blender -b -P shot.py` sets __file__ to the script's path; the Scripting tab (Text
+    Editor, Run Script) sets it to '<the .blend's path>/<text name>' instead, and the file on
+    disk is the text's filepath. No sys.argv: Blender's own arguments are there."""
+    candidates = [globals().get('__file__')]
+    space = getattr(bpy.context, 'space_data', None)
+    if space is not None and space.type == 'TEXT_EDITOR' and space.text is not None:
+        candidates.append(space.text.filepath)
+    candidates += [t.filepath for t in bpy.data.texts if t.name == SHOT['script']]
+    candidates += [t.filepath for t in bpy.data.texts]
+    for c in candidates:
+        if not c:
+            continue
+        folder = os.path.dirname(os.path.abspath(bpy.path.abspath(c)))
+        if os.path.isdir(os.path.join(folder, SHOT['assets'])):
+            return folder
+    raise RuntimeError('%s: its assets folder %s was not found beside it: open the script from '
+                       'the folder augocc export-blender wrote it to (Text Editor: Text > Open) '
+                       'and Run Script, or run: blender -b -P %s' %
+                       (SHOT['script'], SHOT['assets'], SHOT['script']))
+
+
+HERE = script_folder()
 
 
 def shot_path(p):
@@ -80,7 +105,7 @@ def read_ply(filepath):
     return xyz, faces, normals, rgb
 
 
-def mesh_object(name, filepath, parent):
+def mesh_object(scene, name, filepath, parent):
     xyz, faces, normals, rgb = read_ply(shot_path(filepath))
     me = bpy.data.meshes.new(name)
     me.vertices.add(len(xyz))
@@ -101,7 +126,7 @@ def mesh_object(name, filepath, parent):
         rgba = np.concatenate([rgb, np.ones((len(rgb), 1))], 1).astype(np.float32)
         attr.data.foreach_set('color', rgba.ravel())
     ob = bpy.data.objects.new(name, me)
-    bpy.context.scene.collection.objects.link(ob)
+    scene.collection.objects.link(ob)
     ob.parent = parent
     return ob
 
@@ -110,8 +135,29 @@ def srgb_to_linear(c):
     return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
 
 
-def setup_scene():
-    scene = bpy.context.scene
+def new_scene():
+    """The scene the shot is built in. `blender -b`: the factory settings' empty scene. The
+    Scripting tab: a scene of its own, `augocc_shot`, made the window's scene; the open file's
+    other scenes stay (resetting the file would free the text that is running), and a shot built
+    by an earlier run is replaced."""
+    if bpy.context.window is None:
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        return bpy.context.scene
+    old = bpy.data.scenes.get('augocc_shot')
+    scene = bpy.data.scenes.new('augocc_shot')
+    bpy.context.window.scene = scene
+    if old is not None:
+        for ob in list(old.objects):
+            bpy.data.objects.remove(ob)
+        bpy.data.scenes.remove(old)
+        # Its meshes, materials, clip and world now have no user (Blender drops such data when
+        # the file is saved anyway).
+        bpy.data.orphans_purge(do_recursive=True)
+        scene.name = 'augocc_shot'
+    return scene
+
+
+def setup_scene(scene):
     scene.render.engine = 'CYCLES'
     scene.cycles.device = 'CPU'
     scene.cycles.samples = SHOT['samples']
@@ -182,7 +228,6 @@ def add_footage(scene, cam):
     clip = bpy.data.movieclips.load(shot_path(SHOT['footage']))
     clip.frame_start = blender_frame(0)
     scene.active_clip = clip
-    W, H = SHOT['width'], SHOT['height']
     d = SHOT['distortion']
     if d:
         tc = clip.tracking.camera
@@ -190,18 +235,18 @@ def add_footage(scene, cam):
         tc.units = 'PIXELS'
         tc.pixel_aspect = 1
         tc.focal_length_pixels = d['focal_px']
-        # Blender's clip pixels: origin at the bottom-left corner, y up.
-        principal = (d['cx'] + 0.5, H - (d['cy'] + 0.5))
+        # In the clip's pixels as the Movie Distortion node and the undistorted background use
+        # them: pixel centres at integers, rows from the bottom (augocc wrote (cx, H - 1 - cy)).
         if hasattr(tc, 'principal_point_pixels'):  # Blender 3.5+
-            tc.principal_point_pixels = principal
+            tc.principal_point_pixels = d['principal_px']
         else:
-            tc.principal = principal
+            tc.principal = d['principal_px']
         tc.distortion_model = d['model']
         if d['model'] == 'POLYNOMIAL':
             tc.k1, tc.k2, tc.k3 = d['k1'], d['k2'], d['k3']
         else:
-            tc.brown_k1, tc.brown_k2, tc.brown_k3 = d['k1'], d['k2'], d['k3']
-            tc.brown_p1, tc.brown_p2 = d['p1'], d['p2']
+            tc.brown_k1, tc.brown_k2, tc.brown_k3, tc.brown_k4 = d['k1'], d['k2'], d['k3'], 0
+            tc.brown_p1, tc.brown_p2 = d['brown_p1'], d['brown_p2']
     cam.data.show_background_images = True
     bg = cam.data.background_images.new()
     bg.source = 'MOVIE_CLIP'
@@ -242,11 +287,11 @@ def add_clones(scene, world):
     (Blender 3.4 has no light linking to keep only their shadows on the virtual objects)."""
     frames = range(SHOT['first_frame'], SHOT['end_frame'])
     for c in SHOT['clones']:
-        ob = mesh_object('clone_' + c['name'], c['file'], world)
+        ob = mesh_object(scene, 'clone_' + c['name'], c['file'], world)
         ob.is_holdout = True
         ob.visible_shadow = False
         for p in c['patches']:
-            po = mesh_object('clone_%s_patches_%04d' % (c['name'], p['key_frame']), p['file'],
+            po = mesh_object(scene, 'clone_%s_patches_%04d' % (c['name'], p['key_frame']), p['file'],
                              world)
             po.is_holdout = True
             po.visible_shadow = False
@@ -263,7 +308,7 @@ def add_clones(scene, world):
 
 def add_objects(scene, world):
     for o in SHOT['objects']:
-        ob = mesh_object(o['name'], o['file'], world)
+        ob = mesh_object(scene, o['name'], o['file'], world)
         mat = bpy.data.materials.new(o['name'])
         mat.use_nodes = True
         bsdf = mat.node_tree.nodes['Principled BSDF']
@@ -298,8 +343,7 @@ def add_ground_and_sun(scene, world):
 
 
 def build_shot():
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = setup_scene()
+    scene = setup_scene(new_scene())
     world = bpy.data.objects.new('augocc_world', None)
     scene.collection.objects.link(world)
     world.matrix_world = mathutils.Matrix(

@@ -4,6 +4,7 @@
 #include "precomp.hpp"
 #include "input_limits.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <strings.h>
 #include <filesystem>
@@ -277,6 +278,28 @@ int jsonDepth(const char* s, size_t n, int stopAt)
     return maxDepth;
 }
 
+// The '>' that ends the markup whose text starts at `i`, past quoted values; `n` when the text
+// ends first (then *openQuote, when given, is the quote still open, or 0).
+size_t xmlMarkupEnd(const char* s, size_t n, size_t i, char* openQuote)
+{
+    char quote = 0;
+    for (; i < n; i++)
+    {
+        if (quote)
+        {
+            if (s[i] == quote)
+                quote = 0;
+        }
+        else if (s[i] == '"' || s[i] == '\'')
+            quote = s[i];
+        else if (s[i] == '>')
+            return i;
+    }
+    if (openQuote)
+        *openQuote = quote;
+    return n;
+}
+
 // XML: elements nest by tags; comments, processing instructions and declarations do not.
 int xmlDepth(const char* s, size_t n, int stopAt)
 {
@@ -312,25 +335,9 @@ int xmlDepth(const char* s, size_t n, int stopAt)
             if (maxDepth > stopAt)
                 return maxDepth;
             // To the tag's end, past quoted attribute values; "/>" closes it at once.
-            i++;
-            char quote = 0;
-            while (i < n)
-            {
-                if (quote)
-                {
-                    if (s[i] == quote)
-                        quote = 0;
-                }
-                else if (s[i] == '"' || s[i] == '\'')
-                    quote = s[i];
-                else if (s[i] == '>')
-                {
-                    if (s[i - 1] == '/')
-                        depth--;
-                    break;
-                }
-                i++;
-            }
+            i = xmlMarkupEnd(s, n, i + 1, nullptr);
+            if (i < n && s[i - 1] == '/')
+                depth--;
             i++;
         }
     }
@@ -389,6 +396,10 @@ void checkYamlTopLevel(const std::string& text, const String& path, const String
         return;  // JSON or XML
     size_t start = 0;
     int line = 0;
+    // The first content line of every document (the file's start, after '---' or '...') must
+    // start a key: after a "..." document end, a line starting with '-' hung the parser too
+    // (fuzz_calibration).
+    bool expectKey = true;
     while (start < text.size())
     {
         size_t end = text.find('\n', start);
@@ -402,22 +413,62 @@ void checkYamlTopLevel(const std::string& text, const String& path, const String
         const size_t first = l.find_first_not_of(" \t");
         if (first == std::string::npos || l[0] == '%' || l[first] == '#')
             continue;
-        if (l.compare(0, 3, "---") == 0)
+        if (l.compare(0, 3, "---") == 0 || l.compare(0, 3, "...") == 0)
         {
-            // A document marker with text glued to it ("---Y:1") hung the parser as well when
-            // a sequence followed (fuzz_scene).
+            // A document marker with text glued to it ("---Y:1", "...-x") hung the parser as
+            // well when a sequence followed (fuzz_scene, fuzz_calibration).
             const size_t rest = l.find_first_not_of(" \t", 3);
             if (rest != std::string::npos && (l[rest] != '#' || rest == 3))
                 CV_Error(Error::StsParseError, path + cv::format(": %s: line %d ('%s'): text "
-                         "after the '---' document marker", what.c_str(), line,
-                         l.substr(0, 40).c_str()));
+                         "after the '%s' document marker", what.c_str(), line,
+                         l.substr(0, 40).c_str(), l.substr(0, 3).c_str()));
+            expectKey = true;
             continue;
         }
-        if (first != 0 || l[0] == '-')
+        if (expectKey && (first != 0 || l[0] == '-'))
             CV_Error(Error::StsParseError, path + cv::format(": %s: line %d ('%s') must start "
                      "a top-level key at the start of the line (the file's top level is a map)",
                      what.c_str(), line, l.substr(0, 40).c_str()));
-        return;
+        expectKey = false;
+    }
+}
+
+// OpenCV 4.6's XML parser reads past the end of the text when the file ends inside markup
+// ("<?xml version=": SEGV, found by fuzz_tracks). Every comment, processing instruction,
+// declaration and tag must be closed, quoted attribute values included, before the end.
+void checkXmlMarkup(const std::string& text, const String& path, const String& what)
+{
+    const size_t n = text.size();
+    auto lineOf = [&](size_t at) {
+        return 1 + (int)std::count(text.begin(), text.begin() + (std::ptrdiff_t)at, '\n');
+    };
+    auto fail = [&](size_t at, const char* problem) {
+        CV_Error(Error::StsParseError, path + cv::format(": %s: line %d ('%s'): %s before the "
+                 "end of the file (cut short?)", what.c_str(), lineOf(at),
+                 text.substr(at, 40).c_str(), problem));
+    };
+    for (size_t i = text.find('<'); i != std::string::npos; i = text.find('<', i))
+    {
+        const size_t start = i;
+        if (!text.compare(i, 4, "<!--"))
+        {
+            const size_t end = text.find("-->", i + 4);
+            if (end == std::string::npos)
+                fail(start, "a comment not closed by '-->'");
+            i = end + 3;
+            continue;
+        }
+        if (!text.compare(i, 2, "<?"))
+        {
+            const size_t end = text.find("?>", i + 2);
+            if (end == std::string::npos)
+                fail(start, "a processing instruction not closed by '?>'");
+        }
+        char quote = 0;
+        i = xmlMarkupEnd(text.data(), n, i + 1, &quote);
+        if (i >= n)
+            fail(start, quote ? "a quoted value not closed" : "markup not closed by '>'");
+        i++;
     }
 }
 
@@ -467,6 +518,9 @@ void checkStorageFile(const String& path, const String& what)
                  "(binary data, not a YAML, JSON or XML text)", what.c_str(),
                  (size_t)((const char*)std::memchr(text.data(), 0, text.size()) - text.data())));
     checkYamlTopLevel(text, path, what);
+    const size_t first = text.find_first_not_of(" \t\r\n");
+    if (first != std::string::npos && text[first] == '<')
+        checkXmlMarkup(text, path, what);
     const int depth = storageNestingDepth(text.data(), text.size(), kMaxStorageDepth);
     if (depth > kMaxStorageDepth)
         CV_Error(Error::StsOutOfRange, path + cv::format(": %s nests deeper than augocc's limit "

@@ -122,6 +122,11 @@ FileStorage openFileStorageForRead(const String& path, const String& what)
 
 } // namespace detail
 
+FileStorage openStorageForRead(const String& path, const String& what)
+{
+    return detail::openFileStorageForRead(path, what);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Tracks
 

@@ -112,8 +112,16 @@ LensView::LensView(const Camera& camera, Size frameSize)
     miny -= kMarginPx;
     maxx += kMarginPx;
     maxy += kMarginPx;
-    // Pixel centres: the ideal image's edge at -0.5 sits at u = minx.
-    const double cx = -minx - 0.5, cy = -miny - 0.5;
+    // Pixel centres: the ideal image's edge at -0.5 sits at u <= minx, its principal point
+    // scale * (cx, cy) plus whole pixels, so that at scale 1 the ideal pixels are the frame's
+    // pixel grid extended: where the lens moves a point by less than half a pixel, a binary
+    // layer (a rasterised object, a matte) warped back to the frame keeps its pixels. With
+    // any other offset it comes back shifted by that offset, up to half a pixel (a virtual
+    // object composited through the lens was 0.15-0.2 px off: doc/blender.md).
+    const double cx = K(0, 2) * scale + std::ceil(-minx - 0.5 - K(0, 2) * scale);
+    const double cy = K(1, 2) * scale + std::ceil(-miny - 0.5 - K(1, 2) * scale);
+    minx = -cx - 0.5;
+    miny = -cy - 0.5;
     idealK_ = Matx33d(fx, skew, cx, 0, fy, cy, 0, 0, 1);
     idealSize_ = Size((int)std::ceil(maxx - minx), (int)std::ceil(maxy - miny));
 

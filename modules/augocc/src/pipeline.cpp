@@ -344,9 +344,12 @@ RunResult runPipeline(const RunOptions& o)
     // Resume: each stage's manifest names what its output was made from; the next stage's
     // names that output's signature, so a stage run again invalidates the ones after it.
     detail::StageManifest mTrack, mSfm, mClone, mMatte, mComposite;
-    const String inputSignature = detail::pathSignature(o.input);  // every frame file: once
+    // Every frame file: once (the quick one is taken again as each stage ends, which finds
+    // frames replaced while a stage read them).
+    const String inputQuick = detail::quickSignature(o.input);
+    const String inputSignature = detail::pathSignature(o.input);
     mTrack.stage = "track";
-    mTrack.signedInput("input", inputSignature);
+    mTrack.signedInput("input", inputSignature, o.input, inputQuick);
     mTrack.option("tracker", "default");
     const bool trackReused = !o.force && detail::manifestMatches(mTrack, tracksPath);
     bool tracksLoaded = false;
@@ -404,7 +407,10 @@ RunResult runPipeline(const RunOptions& o)
     mClone.input("reconstruction", recPath);
     mClone.input("tracks", tracksPath);
     mClone.input("masks", o.masksDir);
-    mClone.signedInput("input", o.photoRefine ? inputSignature : String("unused"));
+    if (o.photoRefine)
+        mClone.signedInput("input", inputSignature, o.input, inputQuick);
+    else
+        mClone.signedInput("input", "unused");
     mClone.option("voxel_pixels", o.voxelPixels);
     mClone.option("free_space", o.freeSpace ? "1" : "0");
     mClone.option("photo_refine", o.photoRefine ? "1" : "0");
@@ -476,7 +482,7 @@ RunResult runPipeline(const RunOptions& o)
             for (const String& f : files)
                 mComposite.input("mesh folder file " + f, f);
         }
-        mComposite.signedInput("input", inputSignature);
+        mComposite.signedInput("input", inputSignature, o.input, inputQuick);
         mComposite.input("clones", clonesPath);
         mComposite.input("reconstruction", recPath);
         mComposite.option("supersample", o.supersample);

@@ -34,7 +34,7 @@ uLong crcOfFile(const fs::path& p, uLong crc)
     return crc;
 }
 
-String fileSignature(const fs::path& p)
+String fileSignature(const fs::path& p, bool hashed = true)
 {
     std::error_code ec;
     const uintmax_t size = fs::file_size(p, ec);
@@ -46,14 +46,14 @@ String fileSignature(const fs::path& p)
     const long long ns = (long long)std::chrono::duration_cast<std::chrono::nanoseconds>(
                              mtime.time_since_epoch()).count();
     String s = cv::format("%llu %lld", (unsigned long long)size, ns);
-    if (size <= kHashedBytes)
+    if (hashed && size <= kHashedBytes)
         s += cv::format(" %08lx", (unsigned long)crcOfFile(p, crc32_z(0L, Z_NULL, 0)));
     return s;
 }
 
 } // namespace
 
-String pathSignature(const String& path)
+static String signatureOf(const String& path, bool hashed)
 {
     fs::path p(path);
     if (path.find('%') != String::npos)
@@ -62,12 +62,12 @@ String pathSignature(const String& path)
     if (!fs::exists(p, ec))
         return "missing";
     if (!fs::is_directory(p, ec))
-        return fileSignature(p);
+        return fileSignature(p, hashed);
     std::vector<std::pair<String, String> > entries;
     for (fs::recursive_directory_iterator it(p, ec), end; !ec && it != end; it.increment(ec))
         if (it->is_regular_file(ec))
             entries.push_back({fs::relative(it->path(), p, ec).generic_string(),
-                               fileSignature(it->path())});
+                               fileSignature(it->path(), hashed)});
     if (ec)
         return "unreadable";
     std::sort(entries.begin(), entries.end());
@@ -78,6 +78,16 @@ String pathSignature(const String& path)
         crc = crc32_z(crc, reinterpret_cast<const Bytef*>(line.data()), line.size());
     }
     return cv::format("folder %d %08lx", (int)entries.size(), (unsigned long)crc);
+}
+
+String pathSignature(const String& path)
+{
+    return signatureOf(path, true);
+}
+
+String quickSignature(const String& path)
+{
+    return signatureOf(path, false);
 }
 
 void StageManifest::option(const String& name, double value)
@@ -133,6 +143,16 @@ void removeManifest(const String& output)
 
 void writeManifest(const StageManifest& m, const String& output)
 {
+    for (const auto& w : m.watched)
+        if (quickSignature(w.first) != w.second)
+        {
+            std::error_code ec;
+            fs::remove_all(output, ec);
+            CV_Error(Error::StsError,
+                     w.first + ": changed while the run read it (its files' sizes or times differ "
+                     "from the start of the " + m.stage + " stage); " + output +
+                     " was made from two versions and is not kept: run again");
+        }
     const String sig = pathSignature(output);
     writeStorageAtomically(manifestPath(output), [&](FileStorage& fsm) {
         fsm << "stage" << m.stage;

@@ -24,6 +24,10 @@ for every purpose of the resume (a file rewritten within the same nanosecond wit
 but other content of more than kHashedBytes is the one change it misses). */
 String pathSignature(const String& path);
 
+/** @brief pathSignature() without the content hash: size and modification time of the file, or
+of every file under the folder. Cheap enough to take again when a stage ends (inputReplaced). */
+String quickSignature(const String& path);
+
 //! Files up to this size are hashed by content in pathSignature() (masks, scene, calibration).
 const size_t kHashedBytes = (size_t)4 << 20;
 
@@ -33,15 +37,22 @@ struct StageManifest
     String stage;  //!< "track", "sfm", "clone", "matte", "composite"
     std::vector<std::pair<String, String> > inputs;   //!< name -> pathSignature()
     std::vector<std::pair<String, String> > options;  //!< name -> value as text
+    //! path -> quickSignature() when the stage started reading it (not written to the file).
+    std::vector<std::pair<String, String> > watched;
 
     void input(const String& name, const String& path)
     {
         inputs.push_back({name, pathSignature(path)});
+        watched.push_back({path, quickSignature(path)});
     }
-    //! An input whose pathSignature() is already known (the frames: signed once per run).
-    void signedInput(const String& name, const String& signature)
+    /** An input whose signatures are already known (the frames: signed once per run, before the
+    first stage reads them); `path` empty: not a file (nothing to watch). */
+    void signedInput(const String& name, const String& signature, const String& path = String(),
+                     const String& quick = String())
     {
         inputs.push_back({name, signature});
+        if (!path.empty())
+            watched.push_back({path, quick});
     }
     void option(const String& name, const String& value) { options.push_back({name, value}); }
     void option(const String& name, double value);
@@ -59,7 +70,10 @@ bool manifestMatches(const StageManifest& m, const String& output);
 //! Removes `output`'s manifest (before the stage rewrites `output`).
 void removeManifest(const String& output);
 
-//! Writes `output`'s manifest atomically: `m` and `output`'s signature now (call after it).
+/** @brief Writes `output`'s manifest atomically: `m` and `output`'s signature now (call after it).
+First checks that no input of `m` was replaced or rewritten while the stage read it (its
+quickSignature() differs from the stage's start): then the output, made from a mixture of two
+versions, is removed and StsError names the input ("changed while the run read it"). */
 void writeManifest(const StageManifest& m, const String& output);
 
 } // namespace detail

@@ -8,6 +8,7 @@
 #include "ground_plane.hpp"
 #include "input_limits.hpp"
 #include "io_internal.hpp"
+#include "scene_detail.hpp"
 
 #include "atomic_write.hpp"
 
@@ -90,16 +91,6 @@ Vec3f readColor(const FileNode& n, const String& file, const String& where)
         if (c[k] < 0 || c[k] > 1)
             sceneError(file, where, "colour components must be in [0, 1]");
     return Vec3f(c);
-}
-
-Matx33d eulerDeg(const Vec3d& deg)
-{
-    const double d2r = CV_PI / 180.0;
-    const double ax = deg[0] * d2r, ay = deg[1] * d2r, az = deg[2] * d2r;
-    const Matx33d Rx(1, 0, 0, 0, std::cos(ax), -std::sin(ax), 0, std::sin(ax), std::cos(ax));
-    const Matx33d Ry(std::cos(ay), 0, std::sin(ay), 0, 1, 0, -std::sin(ay), 0, std::cos(ay));
-    const Matx33d Rz(std::cos(az), -std::sin(az), 0, std::sin(az), std::cos(az), 0, 0, 0, 1);
-    return Rz * Ry * Rx;
 }
 
 Matx44d affine(const Matx33d& A, const Vec3d& t)
@@ -486,6 +477,37 @@ Sun resolveSun(const VirtualScene& scene, const Reconstruction& rec)
 }
 
 // ---------------------------------------------------------------------------------------------
+// Rotations of scene files
+
+namespace detail {
+
+Matx33d eulerDegToRotation(const Vec3d& deg)
+{
+    const double d2r = CV_PI / 180.0;
+    const double ax = deg[0] * d2r, ay = deg[1] * d2r, az = deg[2] * d2r;
+    const Matx33d Rx(1, 0, 0, 0, std::cos(ax), -std::sin(ax), 0, std::sin(ax), std::cos(ax));
+    const Matx33d Ry(std::cos(ay), 0, std::sin(ay), 0, 1, 0, -std::sin(ay), 0, std::cos(ay));
+    const Matx33d Rz(std::cos(az), -std::sin(az), 0, std::sin(az), std::cos(az), 0, 0, 0, 1);
+    return Rz * Ry * Rx;
+}
+
+Vec3d rotationToEulerDeg(const Matx33d& R)
+{
+    // R = Rz Ry Rx: R(2,0) = -sin y, R(2,1) = cos y sin x, R(2,2) = cos y cos x,
+    // R(1,0) = sin z cos y, R(0,0) = cos z cos y.
+    const double r2d = 180.0 / CV_PI;
+    const double cy = std::sqrt(R(0, 0) * R(0, 0) + R(1, 0) * R(1, 0));
+    const double ay = std::atan2(-R(2, 0), cy);
+    if (cy > 1e-9)
+        return Vec3d(std::atan2(R(2, 1), R(2, 2)) * r2d, ay * r2d,
+                     std::atan2(R(1, 0), R(0, 0)) * r2d);
+    // Gimbal lock (y = +-90): only x -+ z is defined; z = 0, x from R(0,1), R(1,1).
+    return Vec3d(std::atan2(-R(1, 2), R(1, 1)) * r2d, ay * r2d, 0.0);
+}
+
+} // namespace detail
+
+// ---------------------------------------------------------------------------------------------
 // Ground frame
 
 Vec3d GroundFrame::toGround(const Vec3d& X) const
@@ -598,7 +620,7 @@ std::vector<Matx44d> scenePoses(const VirtualScene& scene, const Reconstruction&
     bool groundReady = false;
     for (const SceneObject& o : scene.objects)
     {
-        const Matx33d Rs = eulerDeg(o.rotationDeg) *
+        const Matx33d Rs = detail::eulerDegToRotation(o.rotationDeg) *
                            Matx33d(o.scale[0], 0, 0, 0, o.scale[1], 0, 0, 0, o.scale[2]);
         if (o.placement == SceneObject::PLACE_ABSOLUTE)
         {

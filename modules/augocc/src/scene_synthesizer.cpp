@@ -803,6 +803,15 @@ int lensMaskFactor(Size idealSize)
     return k;
 }
 
+// Offset (fine pixels) of the finer view's grid: with an even factor no fine sample would sit on
+// an ideal pixel's centre, and the ideal pixels' centres are the frame's (LensView, at scale 1),
+// so every pixel's nearest sample would be a quarter ideal pixel off in the same direction (a
+// 0.25 px shift of every mask edge); half a fine pixel puts a sample on each centre.
+double lensMaskPhase(int factor)
+{
+    return factor % 2 == 0 ? 0.5 : 0.0;
+}
+
 // The map (frame size, CV_32FC2) from each frame pixel to the pixel of the ideal view rendered
 // `factor` times finer that sees its ray; cached in `gl` for the view.
 const Mat& lensMaskMap(GlScene& gl, const Ptr<const LensView>& view, int factor)
@@ -810,6 +819,7 @@ const Mat& lensMaskMap(GlScene& gl, const Ptr<const LensView>& view, int factor)
     if (gl.maskView == view && gl.maskFactor == factor)
         return gl.maskMap;
     const Size fs = view->frameSize();
+    const double phase = lensMaskPhase(factor);
     Mat map(fs, CV_32FC2);
     parallel_for_(Range(0, fs.height), [&](const Range& r) {
         for (int y = r.start; y < r.end; y++)
@@ -818,8 +828,8 @@ const Mat& lensMaskMap(GlScene& gl, const Ptr<const LensView>& view, int factor)
             for (int x = 0; x < fs.width; x++)
             {
                 const Point2d q = view->frameToIdeal(Point2d(x, y));
-                row[x] = Point2f((float)(factor * (q.x + 0.5) - 0.5),
-                                 (float)(factor * (q.y + 0.5) - 0.5));
+                row[x] = Point2f((float)(factor * (q.x + 0.5) - 0.5 + phase),
+                                 (float)(factor * (q.y + 0.5) - 0.5 + phase));
             }
         }
     });
@@ -868,7 +878,10 @@ void renderView(GlScene& gl, const SceneModel& m, const Camera& cam, Size size, 
     rest.labels = out.labels ? &labels : nullptr;
     rest.depth = out.depth ? &depth : nullptr;
     rest.whole = out.whole ? &whole : nullptr;
-    renderPasses(gl, m, supersampledCamera(ideal, factor),
+    Camera fine = supersampledCamera(ideal, factor);
+    fine.K(0, 2) += lensMaskPhase(factor);
+    fine.K(1, 2) += lensMaskPhase(factor);
+    renderPasses(gl, m, fine,
                  Size(idealSize.width * factor, idealSize.height * factor), extra, extraCorners,
                  rest);
     const Mat& map = lensMaskMap(gl, view, factor);

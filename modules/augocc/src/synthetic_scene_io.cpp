@@ -174,12 +174,14 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
     if ((int)scene.labels.size() != F || (int)scene.depth.size() != F)
         CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: frames, labels and depth differ "
                  "in count");
+    String staged;  // the temporary folder writeAtomically builds DIR in
     try
     {
         const fs::path target(dir);
         if (target.has_parent_path())
             fs::create_directories(target.parent_path());
         writeAtomically(dir, [&](const String& tmpPath) {
+            staged = tmpPath;
             const fs::path tmp(tmpPath);
             fs::create_directories(tmp / "frames");
             fs::create_directories(tmp / "gt" / "labels");
@@ -253,6 +255,17 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
     {
         // Disk full, permissions...: nothing partial is left (writeAtomically cleans up).
         CV_Error(Error::StsError, dir + ": " + e.what());
+    }
+    catch (const cv::Exception& e)
+    {
+        // The writers name the file they write, inside the temporary folder: name it in DIR,
+        // the folder the user asked for (the temporary is gone).
+        if (staged.empty() || e.err.find(staged) == String::npos)
+            throw;
+        String msg = e.err;
+        for (size_t at; (at = msg.find(staged)) != String::npos;)
+            msg.replace(at, staged.size(), dir);
+        CV_Error(e.code, msg);
     }
 }
 

@@ -70,6 +70,7 @@ Every type, function and file of the module follows these; headers do not restat
 #include "opencv2/augocc/blender_export.hpp"
 #include "opencv2/augocc/evaluation.hpp"
 #include "opencv2/augocc/silhouette_editor.hpp"
+#include "opencv2/augocc/placement_editor.hpp"
 #include "opencv2/augocc/key_frames.hpp"
 #include "opencv2/augocc/visualization.hpp"
 

@@ -291,6 +291,15 @@ nothing, every write checked (imwrite itself does not report a full disk). StsEr
 when the image cannot be encoded or written. */
 CV_EXPORTS void writeImageAtomically(const String& path, InputArray image);
 
+/** @brief Opens a YAML, JSON or XML file (optionally gzipped) of the user's for reading with
+cv::FileStorage, after the limits every augocc reader applies (size, nesting depth, NUL bytes,
+markup cut short: OpenCV 4.6's parsers crash or hang on such files; README, "Input limits").
+@param path the file.
+@param what what the file is, for the messages ("shots file").
+cv::Exception naming `path` and the problem when it is missing, over a limit or does not parse.
+*/
+CV_EXPORTS FileStorage openStorageForRead(const String& path, const String& what = "file");
+
 //! @}
 
 } // namespace augocc
