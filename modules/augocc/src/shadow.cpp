@@ -32,7 +32,8 @@ double biasTexels(const Vec3d& n, const Vec3d& L)
 // The (2r + 2)^2 texels the PCF taps of (u, v) read, compared with depth zr, weighted
 // separably: the taps at offsets -r..r read texels x0 - r .. x0 + r + 1 with weights
 // (1 - fx), 1, ..., 1, fx (and the same in y). `b` (optional) is a second map of the same layout.
-void pcf(const Mat& a, const Mat* b, double u, double v, float zr, float& va, float& vb)
+void pcf(const Mat& a, const Mat* b, double u, double v, float zra, float zrb, float& va,
+         float& vb)
 {
     const int r = Sun::kPcfRadius, n = 2 * r + 2;
     const int x0 = cvFloor(u), y0 = cvFloor(v);
@@ -67,10 +68,10 @@ void pcf(const Mat& a, const Mat* b, double u, double v, float zr, float& va, fl
                     rb += wx[i];
                     continue;
                 }
-                const bool litA = za[x] >= zr;
+                const bool litA = za[x] >= zra;
                 ra += litA ? wx[i] : 0.f;
                 if (zb)
-                    rb += litA && zb[x] >= zr ? wx[i] : 0.f;
+                    rb += litA && zb[x] >= zrb ? wx[i] : 0.f;
             }
         }
         sa += wy[j] * ra;
@@ -187,10 +188,97 @@ void ShadowMap::visibility2(const ShadowMap& other, const Vec3d& X, const Vec3d&
     const bool inThis = near(occupied), inOther = useOther && near(other.occupied);
     if (!inThis && !inOther)
         return;
-    const float zr = (float)(Xc[2] - biasTexels(n, L) * texel);
-    pcf(z, inOther ? &other.z : nullptr, u, v, zr, alone, both);
+    const double zr = Xc[2] - biasTexels(n, L) * texel;
+    pcf(z, inOther ? &other.z : nullptr, u, v, (float)(zr - extraBias),
+        (float)(zr - other.extraBias), alone, both);
     if (!inOther)
         both = alone;
+}
+
+bool ShadowMap::reaches(const Vec3d& X) const
+{
+    if (z.empty() || occupied.area() == 0)
+        return false;
+    const Vec3d Xc = cam.toCamera(X);
+    const double u = Xc[0] * cam.s + cam.pp.x, v = Xc[1] * cam.s + cam.pp.y;
+    const double reach = Sun::kPcfRadius + 2;
+    return u > occupied.x - reach && u < occupied.x + occupied.width - 1 + reach &&
+           v > occupied.y - reach && v < occupied.y + occupied.height - 1 + reach;
+}
+
+void depthVisibility(const Camera& cam, const Mat& depth, const ShadowMap& a, const ShadowMap* b,
+                     Mat& va, Mat* vb, Mat* cosine, const Mat& groundMask, const Vec3d& up,
+                     bool onlyNearB)
+{
+    CV_CheckTypeEQ(depth.type(), CV_32FC1, "depthVisibility: depth");
+    Mat points, normals;
+    surfaceFromDepth(cam, depth, points, normals);
+    const Size sz = depth.size();
+    va.create(sz, CV_32F);
+    if (vb)
+        vb->create(sz, CV_32F);
+    if (cosine)
+        cosine->create(sz, CV_32F);
+    const ShadowMap none;
+    const ShadowMap& other = b ? *b : none;
+    const Vec3d L = a.L;
+    parallel_for_(Range(0, sz.height), [&](const Range& r) {
+        for (int y = r.start; y < r.end; y++)
+        {
+            const Vec3f* p = points.ptr<Vec3f>(y);
+            const Vec3f* nn = normals.ptr<Vec3f>(y);
+            const uchar* g = groundMask.empty() ? nullptr : groundMask.ptr<uchar>(y);
+            float* oa = va.ptr<float>(y);
+            float* ob = vb ? vb->ptr<float>(y) : nullptr;
+            float* oc = cosine ? cosine->ptr<float>(y) : nullptr;
+            for (int x = 0; x < sz.width; x++)
+            {
+                float al = 1.f, bo = 1.f, c = 0.f;
+                if (std::isfinite(p[x][0]))
+                {
+                    const Vec3d n = g && g[x] ? up : Vec3d(nn[x]);
+                    c = (float)std::max(0.0, n.dot(L));
+                    if (!(onlyNearB && b && !b->reaches(Vec3d(p[x]))))
+                        a.visibility2(other, Vec3d(p[x]), n, al, bo);
+                }
+                oa[x] = al;
+                if (ob)
+                    ob[x] = bo;
+                if (oc)
+                    oc[x] = c;
+            }
+        }
+    });
+}
+
+void applyVisibility(const Mat& lit, const Mat& ambient, const Mat& vis, Mat& out)
+{
+    CV_CheckDepthEQ(lit.depth(), CV_8U, "applyVisibility: lit");
+    CV_CheckTypeEQ(lit.type(), ambient.type(), "applyVisibility: ambient");
+    CV_CheckEQ(lit.size(), ambient.size(), "applyVisibility: ambient size");
+    CV_CheckEQ(lit.size(), vis.size(), "applyVisibility: visibility size");
+    CV_CheckTypeEQ(vis.type(), CV_32FC1, "applyVisibility: visibility");
+    const int cn = lit.channels();
+    if (out.data != lit.data)
+        lit.copyTo(out);
+    parallel_for_(Range(0, lit.rows), [&](const Range& r) {
+        for (int y = r.start; y < r.end; y++)
+        {
+            uchar* o = out.ptr<uchar>(y);
+            const uchar* am = ambient.ptr<uchar>(y);
+            const float* v = vis.ptr<float>(y);
+            for (int x = 0; x < lit.cols; x++)
+            {
+                if (v[x] >= 1.f)
+                    continue;
+                for (int k = 0; k < std::min(cn, 3); k++)
+                {
+                    const float l = o[cn * x + k], a = am[cn * x + k];
+                    o[cn * x + k] = saturate_cast<uchar>(a + v[x] * (l - a));
+                }
+            }
+        }
+    });
 }
 
 void renderShadowDepth(GlContext& ctx, ShadowMap& map, const std::function<void()>& draw)

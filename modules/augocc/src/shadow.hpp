@@ -42,6 +42,9 @@ struct CV_EXPORTS ShadowMap
     Vec3d L;               //!< unit, towards the sun
     Rect occupied;         //!< bounding box of the finite texels (empty: no caster)
     double zNear = 0, zFar = 1;  //!< light-camera depth range that holds the casters
+    /** Extra depth bias (world units) of a receiver compared with this map: casters whose
+    depth is not their surface's (the clones' voxel splats hold voxel-centre depths: one voxel). */
+    double extraBias = 0;
 
     /** @brief Lays out the map over the casters' points (world) for the sun; z all +inf. */
     void layout(const Sun& sun, const std::vector<Vec3d>& casterPoints);
@@ -60,7 +63,35 @@ struct CV_EXPORTS ShadowMap
     casters. */
     void visibility2(const ShadowMap& other, const Vec3d& X, const Vec3d& n, float& alone,
                      float& both) const;
+    //! True when a caster of this map is within the filter's reach of X (as the sun sees it).
+    bool reaches(const Vec3d& X) const;
 };
+
+/** @brief The sun's visibility of every pixel of a camera-space depth map (CV_32F, +inf: none).
+@param cam the camera of the depth map.
+@param depth CV_32F camera-space z.
+@param a a shadow map.
+@param b optional second map of the same layout (nullptr: none).
+@param va output CV_32F: visibility against `a` (1 where no surface).
+@param vb optional output CV_32F: against `a` and `b` together.
+@param cosine optional output CV_32F: max(0, n . L) of the surface (0 where none).
+@param groundMask optional CV_8U: pixels whose normal is `up` (the real ground), not estimated.
+@param up the ground's unit normal for groundMask.
+@param onlyNearB with `b`: 1 in both outputs where `b` has no caster near the point (only the
+change `b` makes is wanted; skips the filtering there).
+Normals from surfaceFromDepth(). Rows in parallel, deterministic. */
+CV_EXPORTS void depthVisibility(const Camera& cam, const Mat& depth, const ShadowMap& a,
+                                const ShadowMap* b, Mat& va, Mat* vb = nullptr,
+                                Mat* cosine = nullptr, const Mat& groundMask = Mat(),
+                                const Vec3d& up = Vec3d(0, 1, 0), bool onlyNearB = false);
+
+/** @brief Shadowed colour of the light model (lighting.hpp): ambient + V (lit - ambient), per
+channel of 8-bit images of one size (3 or 4 channels; a 4th channel is taken from `lit`).
+@param lit the colour with the sun (V = 1).
+@param ambient the colour without it (V = 0).
+@param vis CV_32F visibility.
+@param out output, lit's type (may be `lit`). */
+CV_EXPORTS void applyVisibility(const Mat& lit, const Mat& ambient, const Mat& vis, Mat& out);
 
 /** @brief Renders the depth of casters into map.z (minimum with what it holds) in `ctx`, which is
 resized to the map (resize it back before rendering a frame). `draw` issues the draw calls with
