@@ -508,6 +508,14 @@ private:
         }
         const Size fsz = frame.size();
         const float inf = std::numeric_limits<float>::infinity();
+        const GroundFrame& gr = params_.ground;
+        const Vec3d up = gr.up / cv::norm(gr.up);
+        const Rect roi = catcherRoi(camera, fsz, up, gr.height);
+        if (roi.area() == 0)
+        {
+            shadowFrame_ = frame;
+            return shadowFrame_;
+        }
         realZ_.create(fsz, CV_32F);
         realZ_.setTo(Scalar::all(inf));
         if (clones)
@@ -536,15 +544,14 @@ private:
                     }
             });
         }
-        const GroundFrame& gr = params_.ground;
-        const Vec3d up = gr.up / cv::norm(gr.up);
         groundMask_.create(fsz, CV_8U);
-        parallel_for_(Range(0, fsz.height), [&](const Range& r) {
+        groundMask_.setTo(Scalar(0));
+        parallel_for_(Range(roi.y, roi.y + roi.height), [&](const Range& r) {
             for (int y = r.start; y < r.end; y++)
             {
                 float* z = realZ_.ptr<float>(y);
                 uchar* g = groundMask_.ptr<uchar>(y);
-                for (int x = 0; x < fsz.width; x++)
+                for (int x = roi.x; x < roi.x + roi.width; x++)
                 {
                     g[x] = 0;
                     const Ray ray = camera.backproject(Point2d(x, y));
@@ -562,18 +569,20 @@ private:
             }
         });
         Mat vReal, vAll, cosine;
-        detail::depthVisibility(camera, realZ_, cloneMap_, &virtualMap_, vReal, &vAll, &cosine,
-                                groundMask_, up, true);
+        // Normals of the clones from one-pixel differences: a longer baseline over their
+        // voxel-centre staircase (3 px) measured no better (doc/lighting.md).
+        detail::depthVisibility(shiftedCamera(camera, roi.tl()), realZ_(roi), cloneMap_,
+                                &virtualMap_, vReal, &vAll, &cosine, groundMask_(roi), up, true);
         frame.copyTo(shadowFrameBuf_);
         const float sky = (float)params_.sun.sky;
-        parallel_for_(Range(0, fsz.height), [&](const Range& r) {
+        parallel_for_(Range(0, roi.height), [&](const Range& r) {
             for (int y = r.start; y < r.end; y++)
             {
                 const float* va = vReal.ptr<float>(y);
                 const float* vb = vAll.ptr<float>(y);
                 const float* c = cosine.ptr<float>(y);
-                uchar* o = shadowFrameBuf_.ptr<uchar>(y);
-                for (int x = 0; x < fsz.width; x++)
+                uchar* o = shadowFrameBuf_.ptr<uchar>(roi.y + y) + 3 * roi.x;
+                for (int x = 0; x < roi.width; x++)
                 {
                     if (!(vb[x] < va[x]) || c[x] <= 0.f)
                         continue;
@@ -586,6 +595,43 @@ private:
         });
         shadowFrame_ = shadowFrameBuf_;
         return shadowFrame_;
+    }
+
+    /* The frame rectangle where the virtual objects' shadow can fall on a real surface above
+    the ground: the projections of their box's corners and of those corners carried down along
+    the sun's rays to the ground plane (receivers lie between a caster and the ground), with the
+    penumbra's reach; the whole frame when a point is behind a perspective camera. */
+    Rect catcherRoi(const Camera& camera, Size fsz, const Vec3d& up, double height) const
+    {
+        const Vec3d L = params_.sun.direction / cv::norm(params_.sun.direction);
+        const double lu = L.dot(up);
+        if (!(lu > 1e-6))
+            return Rect(Point(), fsz);
+        double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+        double ppu = 0;
+        for (int c = 0; c < 8; c++)
+        {
+            const Vec3d X = boundsCorner(c);
+            const Vec3d pts[2] = {X, X - L * ((up.dot(X) - height) / lu)};
+            for (const Vec3d& P : pts)
+            {
+                const double z = camera.depth(P);
+                if (camera.model == PERSPECTIVE && !(z > 0))
+                    return Rect(Point(), fsz);
+                ppu = std::max(ppu, camera.pixelsPerUnit(z));
+                const Point2d u = camera.project(P);
+                x0 = std::min(x0, u.x);
+                x1 = std::max(x1, u.x);
+                y0 = std::min(y0, u.y);
+                y1 = std::max(y1, u.y);
+            }
+        }
+        // The penumbra's reach (the filter's taps, spread along the ground), and 2 px.
+        const double m = 2 + (Sun::kPcfRadius + 2) * virtualMap_.texel * ppu / std::max(lu, 0.1);
+        const Rect r(Point(std::max(0, cvFloor(x0 - m)), std::max(0, cvFloor(y0 - m))),
+                     Point(std::min(fsz.width, cvCeil(x1 + m) + 1),
+                           std::min(fsz.height, cvCeil(y1 + m) + 1)));
+        return r.width > 0 && r.height > 0 ? r : Rect();
     }
 
     // The virtual samples read back (rgbaUp_, bottom-up, window depth depthUp_) shaded by the

@@ -350,15 +350,27 @@ ShadowScore scoreShadows(InputArray referenceArr, InputArray compositeArr, Input
     const Mat bc = boundary(sc0), bt = boundary(st0);
     const int nc = cv::countNonZero(bc), nt = cv::countNonZero(bt);
     sc.boundaryPixels = nc + nt;
-    if (nc == 0 || nt == 0)
-    {
-        sc.boundaryDistance = nc + nt == 0 ? 0.0 : std::max(ref.cols, ref.rows);
+    if (nc + nt == 0)
         return sc;
-    }
-    Mat dc, dt;
-    cv::distanceTransform(~bc, dc, DIST_L2, DIST_MASK_PRECISE);
-    cv::distanceTransform(~bt, dt, DIST_L2, DIST_MASK_PRECISE);
-    sc.boundaryDistance = 0.5 * (cv::mean(dt, bc)[0] + cv::mean(dc, bt)[0]);
+    // Distances to the other image's boundary; where it has none (its shadow there is fainter
+    // than kShadowDepth), to its pixels that differ from the reference by more than the
+    // tolerance; where it has neither, as far as it gets in the image.
+    const Mat faintC = (cv::abs(gc - gr) > greyTolerance) & in;
+    const Mat faintT = (cv::abs(gt - gr) > greyTolerance) & in;
+    auto meanTo = [&](const Mat& from, const Mat& edge, const Mat& faint) {
+        const Mat to = cv::countNonZero(edge) > 0 ? edge : faint;
+        if (cv::countNonZero(to) == 0)
+            return (double)std::max(ref.cols, ref.rows);
+        Mat d;
+        cv::distanceTransform(~to, d, DIST_L2, DIST_MASK_PRECISE);
+        return cv::mean(d, from)[0];
+    };
+    double sum = 0;
+    if (nc > 0)
+        sum += nc * meanTo(bc, bt, faintT);
+    if (nt > 0)
+        sum += nt * meanTo(bt, bc, faintC);
+    sc.boundaryDistance = sum / (nc + nt);
     return sc;
 }
 

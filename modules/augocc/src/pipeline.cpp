@@ -568,8 +568,8 @@ SceneSun demoSun()
     SceneSun sun;
     sun.form = SceneSun::SUN_AZIMUTH_ELEVATION;
     sun.azimuthDeg = 150;
-    sun.elevationDeg = 40;
-    sun.sky = 0.4;
+    sun.elevationDeg = 55;
+    sun.sky = 0.5;
     sun.penumbraPx = 3;
     return sun;
 }

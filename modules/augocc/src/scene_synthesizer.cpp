@@ -698,9 +698,12 @@ void renderSunShadow(GlScene& gl, const SceneModel& m,
                      const std::vector<Vec3f>& extraCorners, detail::ShadowMap& map)
 {
     std::vector<Vec3d> pts;
-    for (const Vec3f& v : m.boundCorners)
-        if (v[1] > 0)  // the objects' boxes (the ground's corners have y = 0)
-            pts.push_back(Vec3d(v));
+    for (const Mesh& o : m.objects)
+    {
+        Vec3f lo, hi;
+        o.bounds(lo, hi);
+        detail::appendBoxCorners(Vec3d(lo), Vec3d(hi), pts);
+    }
     for (const Vec3f& v : extraCorners)
         pts.push_back(Vec3d(v));
     map.layout(gl.sun, pts);

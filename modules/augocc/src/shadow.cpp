@@ -208,11 +208,11 @@ bool ShadowMap::reaches(const Vec3d& X) const
 
 void depthVisibility(const Camera& cam, const Mat& depth, const ShadowMap& a, const ShadowMap* b,
                      Mat& va, Mat* vb, Mat* cosine, const Mat& groundMask, const Vec3d& up,
-                     bool onlyNearB)
+                     bool onlyNearB, int normalStep)
 {
     CV_CheckTypeEQ(depth.type(), CV_32FC1, "depthVisibility: depth");
     Mat points, normals;
-    surfaceFromDepth(cam, depth, points, normals);
+    surfaceFromDepth(cam, depth, points, normals, normalStep);
     const Size sz = depth.size();
     va.create(sz, CV_32F);
     if (vb)
@@ -314,8 +314,9 @@ void renderShadowDepth(GlContext& ctx, ShadowMap& map, const std::function<void(
     map.addDepth(zc);
 }
 
-void surfaceFromDepth(const Camera& cam, const Mat& depth, Mat& points, Mat& normals)
+void surfaceFromDepth(const Camera& cam, const Mat& depth, Mat& points, Mat& normals, int step)
 {
+    CV_CheckGE(step, 1, "surfaceFromDepth: step");
     CV_CheckTypeEQ(depth.type(), CV_32FC1, "surfaceFromDepth: depth");
     const Size sz = depth.size();
     const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -361,7 +362,7 @@ void surfaceFromDepth(const Camera& cam, const Mat& depth, Mat& points, Mat& nor
                     return std::isfinite(best);
                 };
                 Vec3d tx, ty;
-                if (!side(1, 0, tx) || !side(0, 1, ty))
+                if (!side(step, 0, tx) || !side(0, step, ty))
                     continue;
                 Vec3d nn = tx.cross(ty);
                 const double len = cv::norm(nn);

@@ -79,11 +79,13 @@ struct CV_EXPORTS ShadowMap
 @param up the ground's unit normal for groundMask.
 @param onlyNearB with `b`: 1 in both outputs where `b` has no caster near the point (only the
 change `b` makes is wanted; skips the filtering there).
+@param normalStep surfaceFromDepth()'s step.
 Normals from surfaceFromDepth(). Rows in parallel, deterministic. */
 CV_EXPORTS void depthVisibility(const Camera& cam, const Mat& depth, const ShadowMap& a,
                                 const ShadowMap* b, Mat& va, Mat* vb = nullptr,
                                 Mat* cosine = nullptr, const Mat& groundMask = Mat(),
-                                const Vec3d& up = Vec3d(0, 1, 0), bool onlyNearB = false);
+                                const Vec3d& up = Vec3d(0, 1, 0), bool onlyNearB = false,
+                                int normalStep = 1);
 
 /** @brief Shadowed colour of the light model (lighting.hpp): ambient + V (lit - ambient), per
 channel of 8-bit images of one size (3 or 4 channels; a 4th channel is taken from `lit`).
@@ -102,8 +104,12 @@ CV_EXPORTS void renderShadowDepth(GlContext& ctx, ShadowMap& map,
 /** @brief World point and unit normal (facing the camera; zero where unknown) of every pixel of a
 camera-space depth map (+inf: none, point NaN). Normals from the smaller of the one-sided depth
 differences along x and y, so that a pixel next to a depth edge takes the side of its own
-surface. Rows in parallel, deterministic. */
-CV_EXPORTS void surfaceFromDepth(const Camera& cam, const Mat& depth, Mat& points, Mat& normals);
+surface. Rows in parallel, deterministic.
+@param step the differences' baseline, pixels: 1 for rendered surfaces; more for the clones'
+voxel splats, whose depth is a staircase of voxel-centre depths (a one-pixel difference there
+gives the step's normal, not the surface's). */
+CV_EXPORTS void surfaceFromDepth(const Camera& cam, const Mat& depth, Mat& points, Mat& normals,
+                                 int step = 1);
 
 //! The corners of an axis-aligned box, for ShadowMap::layout().
 CV_EXPORTS void appendBoxCorners(const Vec3d& lo, const Vec3d& hi, std::vector<Vec3d>& out);

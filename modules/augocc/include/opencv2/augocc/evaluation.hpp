@@ -67,8 +67,9 @@ A pixel has a shadow in an image when its grey level differs from the unshadowed
 more than the tolerance; the band is where the composite or the truth has one, and
 fractionWithin the fraction of the band where the two agree within the tolerance. The shadow
 region of an image is where its grey level is below (1 - kShadowDepth) times the reference's;
-boundaryDistance averages, over the boundary pixels of each region (those more than 2 px from
-the pixels `mask` leaves out), the distance to the other region's boundary.
+boundaryDistance averages, over the boundary pixels of both regions (those more than 2 px from
+the pixels `mask` leaves out), the distance to the other region's boundary (to the other
+image's band pixels where its region has no boundary: a fainter shadow).
 @param reference the unshadowed image (the input frame; for virtual objects, their colour
 without the shadows being scored), BGR CV_8UC3.
 @param composite the composite, BGR CV_8UC3.

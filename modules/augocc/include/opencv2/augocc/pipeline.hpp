@@ -231,9 +231,10 @@ struct CV_EXPORTS DemoResult
 };
 
 /** @brief The demo scene's sun: azimuth 150 degrees (clockwise from north, north = the mean
-view direction: from behind the camera, on its right), elevation 40 degrees, sky share 0.4,
-penumbra 3 px; the tree's shadow falls on the front building and the ground, the building's on
-the dome. */
+view direction: from behind the camera, on its right), elevation 55 degrees, sky share 0.5,
+penumbra 3 px: the building's shadow falls on the dome, the dome's and the tree's on the ground.
+(Elevation 40 with sky 0.4 left the L-block's inner corner in deep shadow, where the clones
+carved worse: occlusion boundary 5.5 px against 0.4 px; doc/lighting.md.) */
 CV_EXPORTS SceneSun demoSun();
 
 /** @brief The embedded demo: synthesizes a scene, writes its video and key-frame masks, a
