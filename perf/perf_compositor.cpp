@@ -61,4 +61,37 @@ BENCHMARK(Augocc_Compositor_composite)->Name("Augocc_Compositor/composite_100k_t
     ->Args({1280, 720, 3, 0})->Args({640, 480, 3, 1})->Args({1280, 720, 3, 1})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The same sphere under a sun (Params::sun): its shadow map, the ambient pass, the shading of
+// the virtual samples and the shadow catcher on a ground plane under it (image y is down, so
+// the ground's up is -y; the plane touches the sphere's bottom), occluder as above.
+void Augocc_Compositor_compositeSun(benchmark::State& state)
+{
+    const Size size((int)state.range(0), (int)state.range(1));
+    const int k = (int)state.range(2);
+    CompositeInputs in = makeInputs(size, k);
+    Compositor::Params p;
+    p.supersample = k;
+    p.sun.direction = cv::normalize(Vec3d(0.3, -0.8, -0.5));
+    p.sun.penumbra = 0.05;
+    p.ground.up = Vec3d(0, -1, 0);
+    p.ground.right = Vec3d(1, 0, 0);
+    p.ground.back = Vec3d(0, 0, -1);
+    p.ground.height = -2;
+    Ptr<Compositor> comp = Compositor::create(p);
+    comp->setVirtualObjects({in.sphere});
+    Mat result;
+    comp->composite(in.frame, in.camera, in.occluder, result);  // upload, context, shadow map
+    for (auto _ : state)
+    {
+        comp->composite(in.frame, in.camera, in.occluder, result);
+        benchmark::DoNotOptimize(result.data);
+    }
+    if (result.empty())
+        state.SkipWithError("empty composite");
+}
+BENCHMARK(Augocc_Compositor_compositeSun)->Name("Augocc_Compositor/composite_100k_tris_sun")
+    ->ArgNames({"w", "h", "supersample"})
+    ->Args({640, 480, 3})->Args({1280, 720, 3})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
 } // namespace

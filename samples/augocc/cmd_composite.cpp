@@ -36,6 +36,7 @@ void runComposite(const Globals& g, const CompositeCliOptions& o)
     const Ptr<CloneSet> clones = CloneSet::load(o.clones);
     const VirtualScene scene = readScene(o.scene);
     const std::vector<Mesh> meshes = placeScene(scene, rec, clones.get());
+    opt.sun = resolveSun(scene, rec);
     opt.supersample = o.hardEdges ? 1 : Compositor::Params().supersample;
     opt.antialiasVirtual = o.antialiasVirtual;
     opt.mattesDir = o.mattes;

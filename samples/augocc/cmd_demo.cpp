@@ -17,6 +17,7 @@ void registerDemo(CLI::App& app, Globals& g)
     auto model = std::make_shared<std::string>("scaled_orthographic");
     auto distance = std::make_shared<double>(DemoOptions().distanceRatio);
     auto lens = std::make_shared<std::string>("self");
+    auto noSun = std::make_shared<bool>(false);
     CLI::App* sub = app.add_subcommand("demo", "synthesize a scene and run the whole pipeline "
                                        "on it (no input needed)");
     sub->add_option("--out-dir", *outDir, "output folder (default augocc_demo)");
@@ -31,7 +32,9 @@ void registerDemo(CLI::App& app, Globals& g)
     sub->add_option("--lens", *lens, "how the run learns the lens: self (from the footage, "
                     "default), calibration (the synthesized calibration.yml, as augocc run "
                     "--calibration; handheld only), ignored (no lens model, for comparison)");
-    sub->callback([&g, outDir, noPhoto, model, distance, distanceOpt, lens]() {
+    sub->add_flag("--no-sun", *noSun, "the fixed light of the shading convention, no shadows "
+                  "(default: the demo scene's sun, shadows both ways)");
+    sub->callback([&g, outDir, noPhoto, model, distance, distanceOpt, lens, noSun]() {
         const bool handheld = *model == "handheld";
         DemoOptions o = handheld ? handheldDemoOptions() : DemoOptions();
         if (*model != "scaled_orthographic" && *model != "perspective" && !handheld)
@@ -57,6 +60,7 @@ void registerDemo(CLI::App& app, Globals& g)
                              "handheld) or ignored");
         o.outDir = *outDir;
         o.photoRefine = !*noPhoto;
+        o.sun = !*noSun;
         ProgressPrinter progress(g);
         o.progress = progress.callback();
         const DemoResult r = runDemo(o);
@@ -80,6 +84,14 @@ void registerDemo(CLI::App& app, Globals& g)
                            "mattes: key frames IoU >= %.4f, non-key mean IoU %.4f",
                            r.slide.median, r.slide.p95, r.slide.max, r.focalErrorPercent,
                            r.keyFrameIoU, r.nonKeyIoU));
+        if (o.sun)
+            info(g, cv::format("shadow agreement with the synthetic ground truth: %.2f%% of the "
+                               "%d band pixels within 8 grey levels on the real surfaces, shadow "
+                               "boundary %.2f px; %.2f%% of %d on the virtual objects, boundary "
+                               "%.2f px", 100 * r.shadowReal.fractionWithin,
+                               r.shadowReal.bandPixels, r.shadowReal.boundaryDistance,
+                               100 * r.shadowVirtual.fractionWithin, r.shadowVirtual.bandPixels,
+                               r.shadowVirtual.boundaryDistance));
     });
 }
 

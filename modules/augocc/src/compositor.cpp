@@ -14,6 +14,7 @@
 #include "gl_context.hpp"
 #include "pinhole.hpp"
 #include "shading.hpp"
+#include "shadow.hpp"
 
 #include <algorithm>
 #include <functional>
@@ -96,7 +97,13 @@ struct GpuVertex
     float x, y, z;
     float r, g, b;
     float u, v;
+    float ar, ag, ab;  // ambient only: the colour in the sun's shadow (Params::sun)
 };
+
+bool sameSun(const Sun& a, const Sun& b)
+{
+    return a.direction == b.direction && a.sky == b.sky && a.penumbra == b.penumbra;
+}
 
 // A mesh on the GPU: interleaved vertices, triangle indices, optional texture.
 struct GpuMesh
@@ -199,7 +206,9 @@ public:
     Params getParams() const CV_OVERRIDE { return params_; }
     void setParams(const Params& p) CV_OVERRIDE
     {
-        if (p.cullBackFaces != params_.cullBackFaces || p.lightRotation != params_.lightRotation)
+        p.sun.validate("Compositor: sun");
+        if (p.cullBackFaces != params_.cullBackFaces || p.lightRotation != params_.lightRotation ||
+            !sameSun(p.sun, params_.sun))
             dirty_ = true;
         if (p.supersample < 1 || p.supersample > 8)
             CV_Error(Error::StsBadArg, cv::format("Compositor: supersample must be in [1, 8], "
@@ -246,13 +255,23 @@ public:
         return Size(frameSize.width * params_.supersample, frameSize.height * params_.supersample);
     }
 
-    void composite(InputArray frameArr, int frameIndex, const Camera& camera,
+    void composite(InputArray frameArr0, int frameIndex, const Camera& camera,
                    const CloneSet& clones, OutputArray result, OutputArray virtualLayer,
                    OutputArray depthOut) CV_OVERRIDE
     {
+        Mat frameArr = frameArr0.getMat();
+        if (!insideLens_ && sunShadows())
+        {
+            // Params::sun: the shadow maps of this frame, the real surfaces' shadow catcher on
+            // the frame itself (through the lens too: the clones render through it).
+            const Mat f0 = checkedFrame(frameArr, camera);
+            prepareShadows(frameIndex, &clones);
+            frameArr = catchShadows(f0, camera, frameIndex, &clones, Mat());
+        }
         if (camera.hasDistortion())
         {
             // The depth test in the lens's ideal view, clones drawn there directly.
+            LensScope scope(insideLens_);
             compositeThroughLens(frameArr, camera, [&](const Mat& black, const Camera& ideal,
                                                        Mat& layer, Mat* depth) {
                 composite(black, frameIndex, ideal, clones, lensResult_, layer,
@@ -303,11 +322,24 @@ public:
         compositeCore(frame, camera, pl, occluderOf, Mat(), result, virtualLayer, depthOut);
     }
 
-    void composite(InputArray frameArr, const Camera& camera, InputArray occluderArr,
+    void composite(InputArray frameArr0, const Camera& camera, InputArray occluderArr,
                    OutputArray result, OutputArray virtualLayer, OutputArray depthOut) CV_OVERRIDE
     {
+        Mat frameArr = frameArr0.getMat();
+        if (!insideLens_ && sunShadows())
+        {
+            // Params::sun: no clones, so the virtual objects alone cast; the occluder depth and
+            // the ground receive.
+            const Mat f0 = checkedFrame(frameArr, camera);
+            prepareShadows(-1, nullptr);
+            const Mat occ0 = occluderArr.getMat();
+            if (!occ0.empty())
+                CV_CheckTypeEQ(occ0.type(), CV_32FC1, "Compositor: occluder depth must be CV_32F");
+            frameArr = catchShadows(f0, camera, -1, nullptr, occ0);
+        }
         if (camera.hasDistortion())
         {
+            LensScope scope(insideLens_);
             // The occluder depth (frame pixels) is resampled into the ideal view's render grid
             // (nearest: depth is not interpolated across edges), the test runs there.
             const Mat frame0 = checkedFrame(frameArr, camera);
@@ -390,6 +422,230 @@ public:
     }
 
 private:
+    // Marks the inner (ideal view) composite of a lens frame: the shadow maps and the shadow
+    // catcher are the outer call's.
+    struct LensScope
+    {
+        bool& flag;
+        explicit LensScope(bool& f) : flag(f) { flag = true; }
+        ~LensScope() { flag = false; }
+    };
+
+    bool sunShadows() const { return params_.sun.enabled() && !meshes_.empty(); }
+
+    // Params::sun, before a frame: the two shadow maps on one lattice over the boxes of the
+    // virtual objects and of the clones' grids; the virtual objects' map rendered again only
+    // when they, the sun or the lattice changed; the clones' for this frame (its patch set),
+    // all +inf without clones. Both in the compositor's context (resized to the map).
+    void prepareShadows(int frameIndex, const CloneSet* clones)
+    {
+        if (!gl_)
+        {
+            gl_.reset(new detail::GlContext(Size(64, 64)));
+            glApi_.load();
+        }
+        else
+            gl_->makeCurrent();
+        uploadIfDirty();
+        std::vector<Vec3d> pts;
+        for (int c = 0; c < 8; c++)
+            pts.push_back(boundsCorner(c));
+        double voxel = 0;
+        if (clones)
+            for (const String& name : clones->objectNames())
+            {
+                Matx33d Rb;
+                Vec3d o;
+                clones->gridPose(name, Rb, o);
+                const Vec3i n = clones->gridSize(name);
+                const double v = clones->voxelSize(name);
+                voxel = std::max(voxel, v);
+                for (int c = 0; c < 8; c++)
+                    pts.push_back(o + Rb * Vec3d((c & 1) ? n[0] * v : 0, (c & 2) ? n[1] * v : 0,
+                                                 (c & 4) ? n[2] * v : 0));
+            }
+        detail::ShadowMap lay;
+        lay.layout(params_.sun, pts);
+        const bool same = virtualVersion_ == meshVersion_ && virtualMap_.size() == lay.size() &&
+                          virtualMap_.cam.pp == lay.cam.pp && virtualMap_.cam.s == lay.cam.s &&
+                          virtualMap_.cam.R == lay.cam.R && virtualMap_.cam.t == lay.cam.t &&
+                          virtualMap_.zNear == lay.zNear && virtualMap_.zFar == lay.zFar;
+        if (!same)
+        {
+            virtualMap_ = lay;
+            virtualMap_.z = lay.z.clone();
+            detail::renderShadowDepth(*gl_, virtualMap_, [&]() { drawDepthOnly(); });
+            virtualMap_.finish();
+            virtualVersion_ = meshVersion_;
+        }
+        cloneMap_ = lay;
+        cloneMap_.z = lay.z.clone();
+        // Voxel splats hold voxel-centre depths: a receiver on a clone sits up to about a
+        // voxel behind its own splat as the sun sees it.
+        cloneMap_.extraBias = 1.5 * voxel;
+        if (clones)
+            for (const String& name : clones->objectNames())
+            {
+                clones->render(name, frameIndex, cloneMap_.cam, cloneMap_.size(), cloneMatte_,
+                               shadowDepth_);
+                cloneMap_.addDepth(shadowDepth_);
+            }
+        cloneMap_.finish();
+    }
+
+    /* The shadow catcher (lighting.hpp): the frame darkened where the virtual objects take the
+    sun from the real surfaces, by ratio = (s + (1 - s) c V_all) / (s + (1 - s) c V_real), c =
+    max(0, n . L): the nearest of the ground plane (Params::ground, normal `up`) and the clones
+    (or the occluder depth), normals of the clones from their depth. Only where the virtual
+    objects' shadow map can reach. */
+    const Mat& catchShadows(const Mat& frame, const Camera& camera, int frameIndex,
+                            const CloneSet* clones, const Mat& occ)
+    {
+        if (!params_.shadowCatcher || virtualMap_.occupied.area() == 0)
+        {
+            shadowFrame_ = frame;
+            return shadowFrame_;
+        }
+        const Size fsz = frame.size();
+        const float inf = std::numeric_limits<float>::infinity();
+        const GroundFrame& gr = params_.ground;
+        const Vec3d up = gr.up / cv::norm(gr.up);
+        const Rect roi = catcherRoi(camera, fsz, up, gr.height);
+        if (roi.area() == 0)
+        {
+            shadowFrame_ = frame;
+            return shadowFrame_;
+        }
+        realZ_.create(fsz, CV_32F);
+        realZ_.setTo(Scalar::all(inf));
+        if (clones)
+            for (const String& name : clones->objectNames())
+            {
+                clones->render(name, frameIndex, camera, fsz, cloneMatte_, cloneDepth_);
+                cv::min(realZ_, cloneDepth_, realZ_);
+            }
+        else if (!occ.empty() && occ.size() == fsz)
+            occ.copyTo(realZ_);
+        else if (!occ.empty())
+        {
+            // The occluder at the render grid: the nearest of each pixel's samples.
+            const int k = occ.cols / fsz.width;
+            CV_CheckEQ(occ.size(), Size(fsz.width * k, fsz.height * k),
+                       "Compositor: occluder depth size");
+            parallel_for_(Range(0, fsz.height), [&](const Range& r) {
+                for (int y = r.start; y < r.end; y++)
+                    for (int x = 0; x < fsz.width; x++)
+                    {
+                        float m = inf;
+                        for (int j = 0; j < k; j++)
+                            for (int i = 0; i < k; i++)
+                                m = std::min(m, occ.at<float>(y * k + j, x * k + i));
+                        realZ_.at<float>(y, x) = m;
+                    }
+            });
+        }
+        groundMask_.create(fsz, CV_8U);
+        groundMask_.setTo(Scalar(0));
+        parallel_for_(Range(roi.y, roi.y + roi.height), [&](const Range& r) {
+            for (int y = r.start; y < r.end; y++)
+            {
+                float* z = realZ_.ptr<float>(y);
+                uchar* g = groundMask_.ptr<uchar>(y);
+                for (int x = roi.x; x < roi.x + roi.width; x++)
+                {
+                    g[x] = 0;
+                    const Ray ray = camera.backproject(Point2d(x, y));
+                    const double dn = up.dot(ray.direction);
+                    if (std::abs(dn) < 1e-12)
+                        continue;
+                    const double lambda = (gr.height - up.dot(ray.origin)) / dn;
+                    const double zg = camera.depth(ray.at(lambda));
+                    if (zg > 0 && zg < z[x])
+                    {
+                        z[x] = (float)zg;
+                        g[x] = 255;
+                    }
+                }
+            }
+        });
+        Mat vReal, vAll, cosine;
+        // Normals of the clones from one-pixel differences: a longer baseline over their
+        // voxel-centre staircase (3 px) measured no better (doc/lighting.md).
+        detail::depthVisibility(shiftedCamera(camera, roi.tl()), realZ_(roi), cloneMap_,
+                                &virtualMap_, vReal, &vAll, &cosine, groundMask_(roi), up, true);
+        frame.copyTo(shadowFrameBuf_);
+        const float sky = (float)params_.sun.sky;
+        parallel_for_(Range(0, roi.height), [&](const Range& r) {
+            for (int y = r.start; y < r.end; y++)
+            {
+                const float* va = vReal.ptr<float>(y);
+                const float* vb = vAll.ptr<float>(y);
+                const float* c = cosine.ptr<float>(y);
+                uchar* o = shadowFrameBuf_.ptr<uchar>(roi.y + y) + 3 * roi.x;
+                for (int x = 0; x < roi.width; x++)
+                {
+                    if (!(vb[x] < va[x]) || c[x] <= 0.f)
+                        continue;
+                    const float ratio = (sky + (1 - sky) * c[x] * vb[x]) /
+                                        (sky + (1 - sky) * c[x] * va[x]);
+                    for (int ch = 0; ch < 3; ch++)
+                        o[3 * x + ch] = saturate_cast<uchar>(o[3 * x + ch] * ratio);
+                }
+            }
+        });
+        shadowFrame_ = shadowFrameBuf_;
+        return shadowFrame_;
+    }
+
+    /* The frame rectangle where the virtual objects' shadow can fall on a real surface above
+    the ground: the projections of their box's corners and of those corners carried down along
+    the sun's rays to the ground plane (receivers lie between a caster and the ground), with the
+    penumbra's reach; the whole frame when a point is behind a perspective camera. */
+    Rect catcherRoi(const Camera& camera, Size fsz, const Vec3d& up, double height) const
+    {
+        const Vec3d L = params_.sun.direction / cv::norm(params_.sun.direction);
+        const double lu = L.dot(up);
+        if (!(lu > 1e-6))
+            return Rect(Point(), fsz);
+        double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+        double ppu = 0;
+        for (int c = 0; c < 8; c++)
+        {
+            const Vec3d X = boundsCorner(c);
+            const Vec3d pts[2] = {X, X - L * ((up.dot(X) - height) / lu)};
+            for (const Vec3d& P : pts)
+            {
+                const double z = camera.depth(P);
+                if (camera.model == PERSPECTIVE && !(z > 0))
+                    return Rect(Point(), fsz);
+                ppu = std::max(ppu, camera.pixelsPerUnit(z));
+                const Point2d u = camera.project(P);
+                x0 = std::min(x0, u.x);
+                x1 = std::max(x1, u.x);
+                y0 = std::min(y0, u.y);
+                y1 = std::max(y1, u.y);
+            }
+        }
+        // The penumbra's reach (the filter's taps, spread along the ground), and 2 px.
+        const double m = 2 + (Sun::kPcfRadius + 2) * virtualMap_.texel * ppu / std::max(lu, 0.1);
+        const Rect r(Point(std::max(0, cvFloor(x0 - m)), std::max(0, cvFloor(y0 - m))),
+                     Point(std::min(fsz.width, cvCeil(x1 + m) + 1),
+                           std::min(fsz.height, cvCeil(y1 + m) + 1)));
+        return r.width > 0 && r.height > 0 ? r : Rect();
+    }
+
+    // The virtual samples read back (rgbaUp_, bottom-up, window depth depthUp_) shaded by the
+    // sun's visibility against the clones and the virtual objects: ambient + V (lit - ambient).
+    void shadeVirtual(const Camera& roiCam, double zNear, double zFar)
+    {
+        Mat z, zTop, vNone, vis, visUp;
+        detail::windowDepthToCameraZ(roiCam, depthUp_, zNear, zFar, z);
+        cv::flip(z, zTop, 0);
+        detail::depthVisibility(roiCam, zTop, cloneMap_, &virtualMap_, vNone, &vis);
+        cv::flip(vis, visUp, 0);
+        detail::applyVisibility(rgbaUp_, ambUp_, visUp, rgbaUp_);
+    }
+
     // A frame through a distorted lens: `pinhole` composites a black image of the ideal view
     // with the ideal camera (virtual layer: straight alpha, BGRA; depth when asked), the layer is
     // premultiplied, warped into the frame bilinearly (LensView::toFrame) over the rectangle it
@@ -620,6 +876,21 @@ private:
                          rgbaUp_.data);
             glReadPixels(roi.x, winY, roi.width, roi.height, GL_DEPTH_COMPONENT, GL_FLOAT,
                          depthUp_.data);
+            if (sunShadows())
+            {
+                // The ambient-only pass over the same depth (the same fragments pass GL_LEQUAL),
+                // mixed with the lit one by the sun's visibility of each virtual sample.
+                glClear(GL_COLOR_BUFFER_BIT);
+                glDepthMask(GL_FALSE);
+                glDepthFunc(GL_LEQUAL);
+                drawMeshes(g == k ? pl.rc : camera, gsz, zNear, zFar, true);
+                glDepthMask(GL_TRUE);
+                glDepthFunc(GL_LESS);
+                ambUp_.create(roi.size(), CV_8UC4);
+                glReadPixels(roi.x, winY, roi.width, roi.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                             ambUp_.data);
+                shadeVirtual(shiftedCamera(g == k ? pl.rc : camera, roi.tl()), zNear, zFar);
+            }
             glDisable(GL_SCISSOR_TEST);
             frameRoi_ = frame(Rect(roi.x / g, roi.y / g, roi.width / g, roi.height / g));
             const Rect cov = coveredRect(rgbaUp_);
@@ -676,6 +947,10 @@ private:
         if (!dirty_)
             return;
         releaseGpu();
+        const bool sunLit = params_.sun.enabled();
+        const Vec3f sunL = sunLit ? Vec3f(params_.sun.direction / cv::norm(params_.sun.direction))
+                                  : Vec3f();
+        meshVersion_++;
         for (const Mesh& m : meshes_)
         {
             const size_t nv = m.vertices.size();
@@ -685,9 +960,13 @@ private:
             cv::parallel_for_(Range(0, (int)nv), [&](const Range& r) {
                 for (int i = r.start; i < r.end; i++)
                 {
-                    const Vec3f n = Vec3f(params_.lightRotation * Vec3d(m.normals[i]));
-                    const Vec3f c = detail::shadeColor(m.material, n,
-                                                       hasColors ? m.colors[i] : Vec3f(1, 1, 1));
+                    const Vec3f base = hasColors ? m.colors[i] : Vec3f(1, 1, 1);
+                    const Vec3f c = sunLit ? detail::shadeColor(m.material, m.normals[i], base,
+                                                                sunL)
+                                           : detail::shadeColor(m.material, Vec3f(
+                                                 params_.lightRotation * Vec3d(m.normals[i])),
+                                                 base);
+                    const Vec3f a = detail::ambientColor(m.material, base);
                     GpuVertex& g = verts[i];
                     g.x = m.vertices[i][0];
                     g.y = m.vertices[i][1];
@@ -697,6 +976,9 @@ private:
                     g.b = c[2];
                     g.u = hasTex ? m.texcoords[i][0] : 0.f;
                     g.v = hasTex ? m.texcoords[i][1] : 0.f;
+                    g.ar = a[0];
+                    g.ag = a[1];
+                    g.ab = a[2];
                 }
             });
             GpuMesh g;
@@ -1006,7 +1288,26 @@ private:
         });
     }
 
-    void drawMeshes(const Camera& cam, Size rsz, double zNear, double zFar)
+    // Every virtual triangle, geometry only (no culling: the sun sees other faces than the
+    // camera), with the caller's matrices: the casters of the virtual objects' shadow map.
+    void drawDepthOnly()
+    {
+        glDisable(GL_TEXTURE_2D);
+        glEnableClientState(GL_VERTEX_ARRAY);
+        for (const GpuMesh& g : gpu_)
+        {
+            glApi_.bindBuffer(kElementArrayBuffer, g.ibo);
+            glApi_.bindBuffer(kArrayBuffer, g.vbo);
+            glVertexPointer(3, GL_FLOAT, sizeof(GpuVertex), (const void*)offsetof(GpuVertex, x));
+            glApi_.drawRangeElements(GL_TRIANGLES, 0, g.vertexCount - 1, g.indexCount,
+                                     GL_UNSIGNED_INT, nullptr);
+        }
+        glDisableClientState(GL_VERTEX_ARRAY);
+        glApi_.bindBuffer(kArrayBuffer, 0);
+        glApi_.bindBuffer(kElementArrayBuffer, 0);
+    }
+
+    void drawMeshes(const Camera& cam, Size rsz, double zNear, double zFar, bool ambient = false)
     {
         const Matx44d P = detail::glProjection(cam, rsz, zNear, zFar).t();
         const Matx44d MV = detail::glModelView(cam).t();
@@ -1014,8 +1315,8 @@ private:
         glLoadMatrixd(P.val);
         glMatrixMode(GL_MODELVIEW);
         glLoadMatrixd(MV.val);
-        glDepthFunc(GL_LESS);
-        glDepthMask(GL_TRUE);
+        glDepthFunc(ambient ? GL_LEQUAL : GL_LESS);
+        glDepthMask(ambient ? GL_FALSE : GL_TRUE);
         glEnableClientState(GL_VERTEX_ARRAY);
         glEnableClientState(GL_COLOR_ARRAY);
         glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
@@ -1047,7 +1348,9 @@ private:
             }
             glApi_.bindBuffer(kArrayBuffer, g.vbo);
             glVertexPointer(3, GL_FLOAT, sizeof(GpuVertex), (const void*)offsetof(GpuVertex, x));
-            glColorPointer(3, GL_FLOAT, sizeof(GpuVertex), (const void*)offsetof(GpuVertex, r));
+            glColorPointer(3, GL_FLOAT, sizeof(GpuVertex),
+                           ambient ? (const void*)offsetof(GpuVertex, ar)
+                                   : (const void*)offsetof(GpuVertex, r));
             if (g.texture)
             {
                 glEnable(GL_TEXTURE_2D);
@@ -1211,6 +1514,12 @@ private:
 
     Params params_;
     std::vector<Mesh> meshes_;
+    // Params::sun: the shadow maps (one lattice), the version of the uploaded meshes the
+    // virtual one holds, and the catcher's buffers.
+    detail::ShadowMap virtualMap_, cloneMap_;
+    int meshVersion_ = 0, virtualVersion_ = -1;
+    bool insideLens_ = false;
+    Mat ambUp_, realZ_, groundMask_, shadowFrame_, shadowFrameBuf_, shadowDepth_;
     Vec3d boundsMin_, boundsMax_;
     bool dirty_ = true;
     std::unique_ptr<detail::GlContext> gl_;

@@ -309,5 +309,70 @@ SlideStats measureSlide(const Reconstruction& recovered, const Reconstruction& t
     return st;
 }
 
+ShadowScore scoreShadows(InputArray referenceArr, InputArray compositeArr, InputArray truthArr,
+                         InputArray maskArr, int greyTolerance)
+{
+    const Mat ref = referenceArr.getMat(), comp = compositeArr.getMat(), truth = truthArr.getMat();
+    const Mat mask = maskArr.getMat();
+    CV_CheckTypeEQ(ref.type(), CV_8UC3, "scoreShadows: reference");
+    CV_CheckTypeEQ(comp.type(), CV_8UC3, "scoreShadows: composite");
+    CV_CheckTypeEQ(truth.type(), CV_8UC3, "scoreShadows: truth");
+    CV_CheckTypeEQ(mask.type(), CV_8UC1, "scoreShadows: mask");
+    CV_CheckEQ(comp.size(), ref.size(), "scoreShadows: composite size");
+    CV_CheckEQ(truth.size(), ref.size(), "scoreShadows: truth size");
+    CV_CheckEQ(mask.size(), ref.size(), "scoreShadows: mask size");
+    Mat gr, gc, gt;
+    cv::cvtColor(ref, gr, COLOR_BGR2GRAY);
+    cv::cvtColor(comp, gc, COLOR_BGR2GRAY);
+    cv::cvtColor(truth, gt, COLOR_BGR2GRAY);
+    gr.convertTo(gr, CV_32F);
+    gc.convertTo(gc, CV_32F);
+    gt.convertTo(gt, CV_32F);
+    const Mat in = mask > 0;
+    const Mat band = ((cv::abs(gc - gr) > greyTolerance) | (cv::abs(gt - gr) > greyTolerance)) & in;
+    ShadowScore sc;
+    sc.bandPixels = cv::countNonZero(band);
+    if (sc.bandPixels > 0)
+        sc.fractionWithin = (double)cv::countNonZero((cv::abs(gc - gt) <= greyTolerance) & band) /
+                            sc.bandPixels;
+    // Shadow regions and their boundaries, away from the pixels left out.
+    const Mat limit = gr * (1 - kShadowDepth);
+    const Mat sc0 = (gc < limit) & in, st0 = (gt < limit) & in;
+    Mat out, nearOut;
+    cv::bitwise_not(in, out);
+    cv::dilate(out, nearOut, getStructuringElement(MORPH_RECT, Size(5, 5)));
+    auto boundary = [&](const Mat& s) {
+        Mat e;
+        cv::erode(s, e, getStructuringElement(MORPH_RECT, Size(3, 3)), Point(-1, -1), 1,
+                  BORDER_REPLICATE);
+        return (s & ~e) & ~nearOut;
+    };
+    const Mat bc = boundary(sc0), bt = boundary(st0);
+    const int nc = cv::countNonZero(bc), nt = cv::countNonZero(bt);
+    sc.boundaryPixels = nc + nt;
+    if (nc + nt == 0)
+        return sc;
+    // Distances to the other image's boundary; where it has none (its shadow there is fainter
+    // than kShadowDepth), to its pixels that differ from the reference by more than the
+    // tolerance; where it has neither, as far as it gets in the image.
+    const Mat faintC = (cv::abs(gc - gr) > greyTolerance) & in;
+    const Mat faintT = (cv::abs(gt - gr) > greyTolerance) & in;
+    auto meanTo = [&](const Mat& from, const Mat& edge, const Mat& faint) {
+        const Mat to = cv::countNonZero(edge) > 0 ? edge : faint;
+        if (cv::countNonZero(to) == 0)
+            return (double)std::max(ref.cols, ref.rows);
+        Mat d;
+        cv::distanceTransform(~to, d, DIST_L2, DIST_MASK_PRECISE);
+        return cv::mean(d, from)[0];
+    };
+    double sum = 0;
+    if (nc > 0)
+        sum += nc * meanTo(bc, bt, faintT);
+    if (nt > 0)
+        sum += nt * meanTo(bt, bc, faintC);
+    sc.boundaryDistance = sum / (nc + nt);
+    return sc;
+}
+
 } // namespace augocc
 } // namespace cv

@@ -171,8 +171,11 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
     Compositor::Params cp;
     cp.supersample = options.supersample;
     cp.antialiasVirtual = options.antialiasVirtual;
+    if (options.lightFromGround || options.sun.enabled())
+        cp.ground = estimateGround(rec);
     if (options.lightFromGround)
-        cp.lightRotation = estimateGround(rec).rotation();
+        cp.lightRotation = cp.ground.rotation();
+    cp.sun = options.sun;
     Ptr<Compositor> comp = Compositor::create(cp);
     comp->setVirtualObjects(virtualObjects);
     VideoWriter writer;
@@ -553,6 +556,10 @@ RunResult runPipeline(const RunOptions& o)
         mComposite.option("antialias_virtual", o.antialiasVirtual ? "1" : "0");
         timer.start();
         r.virtualObjects = placeScene(scene, r.reconstruction, r.clones.get());
+        const Sun sun = resolveSun(scene, r.reconstruction);
+        mComposite.option("sun", cv::format("%.9g %.9g %.9g %.9g %.9g", sun.direction[0],
+                                            sun.direction[1], sun.direction[2], sun.sky,
+                                            sun.penumbra));
         r.compositePath = compositePath;
         if (!o.force && detail::manifestMatches(mComposite, compositePath))
             r.reused.push_back("composite");
@@ -562,6 +569,7 @@ RunResult runPipeline(const RunOptions& o)
             CompositeOptions co;
             co.supersample = o.supersample;
             co.antialiasVirtual = o.antialiasVirtual;
+            co.sun = sun;
             co.firstFrame = r.reconstruction.cameras.front().frame;
             co.endFrame = r.reconstruction.cameras.back().frame + 1;
             co.progress = o.progress;
@@ -615,7 +623,19 @@ VirtualScene demoVirtualScene(const String& path)
     tree.size = 0.6;
     tree.offset = Vec3d(-0.2, 0, 0);
     s.objects = {dome, tree};
+    s.sun = demoSun();
     return s;
+}
+
+SceneSun demoSun()
+{
+    SceneSun sun;
+    sun.form = SceneSun::SUN_AZIMUTH_ELEVATION;
+    sun.azimuthDeg = 150;
+    sun.elevationDeg = 55;
+    sun.sky = 0.5;
+    sun.penumbraPx = 3;
+    return sun;
 }
 
 DemoOptions handheldDemoOptions()
@@ -654,6 +674,33 @@ DemoResult runDemo(const DemoOptions& o)
     sp.videoBitrateMbps = o.videoBitrateMbps;
     sp.progress = o.progress;
     Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(sp);
+    VirtualScene demoScene = demoVirtualScene((dir / "scene.yml").string());
+    if (o.sun)
+    {
+        // The sun of the scene file in the true world: its ground (y up, the plane y = 0) with
+        // north the true cameras' mean view direction, as resolveSun() takes it from the
+        // reconstruction's estimated ground; penumbra pixels of the first camera at the origin.
+        Reconstruction gt;
+        gt.model = sp.model;
+        gt.imageSize = sp.imageSize;
+        for (int f = 0; f < sp.frames; f++)
+            gt.cameras.push_back(synth->getCamera(f));
+        GroundFrame g = estimateGround(gt);
+        g.up = Vec3d(0, 1, 0);
+        g.height = 0;
+        Vec3d fwd = -g.back - g.up * g.up.dot(-g.back);
+        fwd = cv::normalize(fwd);
+        g.right = cv::normalize(fwd.cross(g.up));
+        g.back = -fwd;
+        const SceneSun& ds = demoScene.sun;
+        sp.sun.direction = sunDirection(g, ds.azimuthDeg, ds.elevationDeg, ds.north);
+        sp.sun.sky = ds.sky;
+        const Camera& c0 = gt.cameras.front();
+        sp.sun.penumbra = ds.penumbraPx / c0.pixelsPerUnit(c0.depth(Vec3d(0, 0, 0)));
+        synth->setParams(sp);
+    }
+    else
+        demoScene.sun = SceneSun();
     SyntheticScene scene;
     synth->synthesize(scene);
     // The input: frames as PNG (lossless) or, at a set bit rate, the synthesized data set with
@@ -679,7 +726,7 @@ DemoResult runDemo(const DemoOptions& o)
     if (sp.model == PERSPECTIVE && o.videoBitrateMbps > 0)
         res.calibrationPath = (dir / "synth" / "calibration.yml").string();
     res.scenePath = (dir / "scene.yml").string();
-    writeScene(res.scenePath, demoVirtualScene(res.scenePath));
+    writeScene(res.scenePath, demoScene);
 
     RunOptions ro;
     ro.input = framesDir;
@@ -710,12 +757,22 @@ DemoResult runDemo(const DemoOptions& o)
                      M(2, 2));
     const double sigma = std::cbrt(cv::determinant(Ma));
     Compositor::Params soft, hard;
-    soft.lightRotation = estimateGround(rec).rotation();
+    soft.ground = estimateGround(rec);
+    soft.lightRotation = soft.ground.rotation();
+    soft.sun = resolveSun(demoScene, rec);
     hard.supersample = 1;
     // The truth is lit in the true world (y up) by the synthesizer: light it the same way here.
     Ptr<Compositor> ours = Compositor::create(soft), ref = Compositor::create(hard);
     ours->setVirtualObjects(res.run.virtualObjects);
     ref->setVirtualObjects(truthMeshes);
+    // The virtual objects under the true sun without the real objects' shadows (no clones,
+    // the true depth as occluder): the reference of the shadows on the virtual objects.
+    Compositor::Params litP = hard;
+    litP.sun = sp.sun;
+    Ptr<Compositor> lit = Compositor::create(litP);
+    lit->setVirtualObjects(truthMeshes);
+    double sumReal = 0, sumVirtual = 0, sumBoundReal = 0, sumBoundVirtual = 0;
+    int boundFramesReal = 0, boundFramesVirtual = 0;
     std::vector<Mat> before, after;
     std::vector<String> captions;
     const int n = (int)scene.frames.size();
@@ -740,6 +797,33 @@ DemoResult runDemo(const DemoOptions& o)
         const CompositeScore s = scoreComposite(result, truth, alphaOf(layer),
                                                 alphaOf(refLayer) > 0, alphaOf(silLayer) > 0);
         res.fractionWithin += s.fractionWithin;
+        if (o.sun)
+        {
+            Mat litImg, litLayer;
+            lit->composite(scene.frames[f], gtCam, real, litImg, litLayer);
+            const Mat a = alphaOf(layer), at = alphaOf(refLayer);
+            Mat anyV = (a > 0) | (at > 0), realMask, bothV, virtualMask;
+            cv::dilate(anyV, anyV, getStructuringElement(MORPH_RECT, Size(3, 3)));
+            cv::bitwise_not(anyV, realMask);
+            bothV = (a == 255) & (at == 255);
+            cv::erode(bothV, virtualMask, getStructuringElement(MORPH_RECT, Size(3, 3)));
+            const ShadowScore sr = scoreShadows(scene.frames[f], result, truth, realMask);
+            const ShadowScore sv = scoreShadows(litImg, result, truth, virtualMask);
+            sumReal += sr.fractionWithin * sr.bandPixels;
+            res.shadowReal.bandPixels += sr.bandPixels;
+            sumVirtual += sv.fractionWithin * sv.bandPixels;
+            res.shadowVirtual.bandPixels += sv.bandPixels;
+            if (sr.boundaryPixels > 0)
+            {
+                sumBoundReal += sr.boundaryDistance;
+                boundFramesReal++;
+            }
+            if (sv.boundaryPixels > 0)
+            {
+                sumBoundVirtual += sv.boundaryDistance;
+                boundFramesVirtual++;
+            }
+        }
         if (s.boundaryPixels > 0 || s.boundaryDistance > 0)
         {
             res.boundaryDistance += s.boundaryDistance;
@@ -792,6 +876,14 @@ DemoResult runDemo(const DemoOptions& o)
         res.nonKeyIoU = cnt > 0 ? sum / cnt : 1.0;
     }
     res.fractionWithin /= scored;
+    if (res.shadowReal.bandPixels > 0)
+        res.shadowReal.fractionWithin = sumReal / res.shadowReal.bandPixels;
+    if (res.shadowVirtual.bandPixels > 0)
+        res.shadowVirtual.fractionWithin = sumVirtual / res.shadowVirtual.bandPixels;
+    res.shadowReal.boundaryPixels = boundFramesReal;
+    res.shadowVirtual.boundaryPixels = boundFramesVirtual;
+    res.shadowReal.boundaryDistance = sumBoundReal / std::max(1, boundFramesReal);
+    res.shadowVirtual.boundaryDistance = sumBoundVirtual / std::max(1, boundFramesVirtual);
     res.boundaryDistance /= std::max(1, res.boundaryFrames);
     res.rotationErrorDeg /= scored;
     std::vector<Mat> sheet;

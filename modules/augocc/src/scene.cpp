@@ -27,6 +27,8 @@ const char* const kObjectKeys[] = {"name", "mesh", "shape", "position", "rotatio
                                    "size", "material", "on_ground_beside", "behind",
                                    "in_front_of", "distance", "side", "offset"};
 const char* const kMaterialKeys[] = {"diffuse", "ambient", "texture"};
+const char* const kSunKeys[] = {"direction", "azimuth", "elevation", "date", "time", "latitude",
+                                "longitude", "north", "sky", "penumbra"};
 
 [[noreturn]] void sceneError(const String& file, const String& where, const String& what)
 {
@@ -104,6 +106,98 @@ Mesh colored(Mesh m, const Vec3f& rgb)
     return m;
 }
 
+// "YYYY-MM-DD" and "HH:MM[:SS]" (UTC) to the date and the hour; throws naming the key.
+void parseDateTime(const SceneSun& sun, const String& file, int& y, int& mo, int& d, double& h)
+{
+    char tail = 0;
+    if (std::sscanf(sun.date.c_str(), "%4d-%2d-%2d%c", &y, &mo, &d, &tail) != 3 || mo < 1 ||
+        mo > 12 || d < 1 || d > 31)
+        sceneError(file, "sun.date", "expected \"YYYY-MM-DD\", got '" + sun.date + "'");
+    int hh = 0, mm = 0;
+    double ss = 0;
+    const int n = std::sscanf(sun.time.c_str(), "%2d:%2d:%lf%c", &hh, &mm, &ss, &tail);
+    if ((n != 2 && n != 3) || hh < 0 || hh > 23 || mm < 0 || mm > 59 || ss < 0 || ss >= 60)
+        sceneError(file, "sun.time", "expected \"HH:MM\" or \"HH:MM:SS\" (UTC), got '" +
+                   sun.time + "'");
+    h = hh + mm / 60.0 + ss / 3600.0;
+}
+
+SceneSun readSun(const FileNode& n, const String& file)
+{
+    checkKeys(n, kSunKeys, sizeof(kSunKeys) / sizeof(kSunKeys[0]), file, "sun");
+    SceneSun sun;
+    const bool dir = !n["direction"].empty();
+    const bool azel = !n["azimuth"].empty() || !n["elevation"].empty();
+    const bool when = !n["date"].empty() || !n["time"].empty() || !n["latitude"].empty() ||
+                      !n["longitude"].empty();
+    if ((int)dir + (int)azel + (int)when != 1)
+        sceneError(file, "sun", "give exactly one of 'direction', 'azimuth' + 'elevation', or "
+                   "'date' + 'time' + 'latitude' + 'longitude'");
+    if (dir)
+    {
+        sun.form = SceneSun::SUN_DIRECTION;
+        sun.direction = readVec3(n["direction"], file, "sun.direction");
+        if (!(cv::norm(sun.direction) > 0))
+            sceneError(file, "sun.direction", "must not be zero");
+        sun.direction /= cv::norm(sun.direction);
+    }
+    else if (azel)
+    {
+        sun.form = SceneSun::SUN_AZIMUTH_ELEVATION;
+        for (const char* k : {"azimuth", "elevation"})
+            if (n[k].empty())
+                sceneError(file, String("sun.") + k, "missing (azimuth and elevation go together)");
+        sun.azimuthDeg = readNumber(n["azimuth"], file, "sun.azimuth");
+        sun.elevationDeg = readNumber(n["elevation"], file, "sun.elevation");
+    }
+    else
+    {
+        sun.form = SceneSun::SUN_DATE_TIME;
+        for (const char* k : {"date", "time", "latitude", "longitude"})
+            if (n[k].empty())
+                sceneError(file, String("sun.") + k, "missing (date, time, latitude and "
+                           "longitude go together)");
+        sun.date = readString(n["date"], file, "sun.date");
+        sun.time = readString(n["time"], file, "sun.time");
+        sun.latitudeDeg = readNumber(n["latitude"], file, "sun.latitude");
+        sun.longitudeDeg = readNumber(n["longitude"], file, "sun.longitude");
+        if (std::abs(sun.latitudeDeg) > 90)
+            sceneError(file, "sun.latitude", "must be in [-90, 90]");
+        if (std::abs(sun.longitudeDeg) > 180)
+            sceneError(file, "sun.longitude", "must be in [-180, 180]");
+        int y, mo, d;
+        double h;
+        parseDateTime(sun, file, y, mo, d, h);
+        solarPosition(y, mo, d, h, sun.latitudeDeg, sun.longitudeDeg, sun.azimuthDeg,
+                      sun.elevationDeg);
+    }
+    if (sun.form != SceneSun::SUN_DIRECTION && !(sun.elevationDeg > 0 && sun.elevationDeg < 90))
+        sceneError(file, sun.form == SceneSun::SUN_DATE_TIME ? "sun.date" : "sun.elevation",
+                   cv::format("the sun is %.2f degrees above the horizon: expected (0, 90)",
+                              sun.elevationDeg));
+    if (!n["north"].empty())
+    {
+        if (dir)
+            sceneError(file, "sun.north", "only valid with azimuth/elevation or date/time");
+        sun.north = readVec3(n["north"], file, "sun.north");
+        if (!(cv::norm(sun.north) > 0))
+            sceneError(file, "sun.north", "must not be zero");
+    }
+    if (!n["sky"].empty())
+    {
+        sun.sky = readNumber(n["sky"], file, "sun.sky");
+        if (!(sun.sky >= 0 && sun.sky < 1))
+            sceneError(file, "sun.sky", "must be in [0, 1)");
+    }
+    if (!n["penumbra"].empty())
+    {
+        sun.penumbraPx = readNumber(n["penumbra"], file, "sun.penumbra");
+        if (!(sun.penumbraPx > 0 && sun.penumbraPx <= 100))
+            sceneError(file, "sun.penumbra", "must be in (0, 100] pixels");
+    }
+    return sun;
+}
+
 } // namespace
 
 std::vector<Mesh> proceduralShape(const String& shape)
@@ -135,14 +229,16 @@ VirtualScene readScene(const String& path)
 {
     const FileStorage fsIn = detail::openFileStorageForRead(path, "scene file");
     const FileNode root = fsIn.root();
-    const char* const rootKeys[] = {"objects"};
-    checkKeys(root, rootKeys, 1, path, "top level");
+    const char* const rootKeys[] = {"objects", "sun"};
+    checkKeys(root, rootKeys, 2, path, "top level");
     const FileNode objs = root["objects"];
     if (objs.empty() || !objs.isSeq() || objs.size() == 0)
         sceneError(path, "objects", "missing or empty: expected a sequence of objects");
 
     VirtualScene scene;
     scene.path = path;
+    if (!root["sun"].empty())
+        scene.sun = readSun(root["sun"], path);
     const fs::path dir = fs::path(path).parent_path();
     std::set<String> names;
     for (int i = 0; i < (int)objs.size(); i++)
@@ -341,7 +437,72 @@ void writeScene(const String& path, const VirtualScene& scene)
             out << "}";
         }
         out << "]";
+        const SceneSun& sun = scene.sun;
+        if (sun.form == SceneSun::SUN_NONE)
+            return;
+        out << "sun" << "{";
+        if (sun.form == SceneSun::SUN_DIRECTION)
+            out << "direction" << "[:" << sun.direction[0] << sun.direction[1]
+                << sun.direction[2] << "]";
+        else if (sun.form == SceneSun::SUN_AZIMUTH_ELEVATION)
+            out << "azimuth" << sun.azimuthDeg << "elevation" << sun.elevationDeg;
+        else
+            out << "date" << sun.date << "time" << sun.time << "latitude" << sun.latitudeDeg
+                << "longitude" << sun.longitudeDeg;
+        if (sun.form != SceneSun::SUN_DIRECTION && sun.north != Vec3d(0, 0, 0))
+            out << "north" << "[:" << sun.north[0] << sun.north[1] << sun.north[2] << "]";
+        out << "sky" << sun.sky << "penumbra" << sun.penumbraPx;
+        out << "}";
     });
+}
+
+Vec3d sunDirection(const GroundFrame& ground, double azimuthDeg, double elevationDeg,
+                   const Vec3d& northIn)
+{
+    const Vec3d north0 = northIn == Vec3d(0, 0, 0) ? -ground.back : northIn;
+    Vec3d north = north0 - ground.up * ground.up.dot(north0);
+    if (!(cv::norm(north) > 1e-9 * std::max(1.0, cv::norm(north0))))
+        CV_Error(Error::StsBadArg, "sunDirection: north is vertical (no horizontal part)");
+    north /= cv::norm(north);
+    const Vec3d east = north.cross(ground.up);
+    const double az = azimuthDeg * CV_PI / 180, el = elevationDeg * CV_PI / 180;
+    const Vec3d d = std::cos(el) * (std::cos(az) * north + std::sin(az) * east) +
+                    std::sin(el) * ground.up;
+    return d / cv::norm(d);
+}
+
+Sun resolveSun(const VirtualScene& scene, const Reconstruction& rec)
+{
+    Sun sun;
+    const SceneSun& s = scene.sun;
+    if (s.form == SceneSun::SUN_NONE)
+        return sun;
+    if (rec.cameras.empty())
+        CV_Error(Error::StsBadArg, scene.path + ": sun: the reconstruction has no camera");
+    const GroundFrame ground = estimateGround(rec);
+    if (s.form == SceneSun::SUN_DIRECTION)
+        sun.direction = s.direction / cv::norm(s.direction);
+    else
+    {
+        try
+        {
+            sun.direction = sunDirection(ground, s.azimuthDeg, s.elevationDeg, s.north);
+        }
+        catch (const cv::Exception& e)
+        {
+            CV_Error(Error::StsBadArg, scene.path + ": sun.north: " + e.err);
+        }
+    }
+    sun.sky = s.sky;
+    // Pixels of the first camera at the ground origin to world units.
+    const Camera& cam = rec.cameras.front();
+    const double ppu = cam.pixelsPerUnit(cam.depth(ground.fromGround(Vec3d(0, 0, 0))));
+    if (!(ppu > 0) || !std::isfinite(ppu))
+        CV_Error(Error::StsBadArg, scene.path + ": sun.penumbra: the first camera sees no scale "
+                 "at the ground origin");
+    sun.penumbra = s.penumbraPx / ppu;
+    sun.validate(scene.path + ": sun");
+    return sun;
 }
 
 // ---------------------------------------------------------------------------------------------

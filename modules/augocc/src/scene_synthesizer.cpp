@@ -11,6 +11,7 @@
 #include "precomp.hpp"
 #include "gl_context.hpp"
 #include "shading.hpp"
+#include "shadow.hpp"
 
 #include <cfloat>
 #include <memory>
@@ -637,9 +638,29 @@ struct GlScene
     Ptr<const LensView> maskView;
     int maskFactor = 0;
     Mat maskMap;
+    // Params::sun: its direction as the meshes' light, and the shadow map of the real objects
+    // (laid out and rendered on first use).
+    Sun sun;
+    Vec3f light = detail::kLightDirection;
+    detail::ShadowMap realShadow;
+    bool realShadowReady = false;
 
-    GlScene(Size size, const SceneModel& m) : ctx(size)
+    GlScene(Size size, const SceneModel& m, const Sun& sunIn) : ctx(size), sun(sunIn)
     {
+        if (sun.enabled())
+        {
+            light = Vec3f(sun.direction / cv::norm(sun.direction));
+            Mesh g = m.ground;
+            g.material = detail::sunSplitMaterial(g.material, sun.sky);
+            ground.reset(new detail::GlMesh(g, 0.f, light));
+            for (size_t i = 0; i < m.objects.size(); i++)
+            {
+                Mesh o = m.objects[i];
+                o.material = detail::sunSplitMaterial(o.material, sun.sky);
+                objects.emplace_back(new detail::GlMesh(o, (float)(i + 1) / 255.f, light));
+            }
+            return;
+        }
         ground.reset(new detail::GlMesh(m.ground, 0.f));
         for (size_t i = 0; i < m.objects.size(); i++)
             objects.emplace_back(new detail::GlMesh(m.objects[i], (float)(i + 1) / 255.f));
@@ -667,7 +688,33 @@ struct PassOutputs
     std::vector<Mat>* whole = nullptr;
     //! CV_32F, the colour's size: the fraction of each pixel the extra (virtual) meshes cover
     Mat* virtualCover = nullptr;
+    //! Params::sun: the casters' shadow map (the colour is shadowed), else null
+    const detail::ShadowMap* shadow = nullptr;
 };
+
+// The shadow map of the sun over the real objects and the extra meshes (GlScene::sun enabled).
+void renderSunShadow(GlScene& gl, const SceneModel& m,
+                     const std::vector<const detail::GlMesh*>& extra,
+                     const std::vector<Vec3f>& extraCorners, detail::ShadowMap& map)
+{
+    std::vector<Vec3d> pts;
+    for (const Mesh& o : m.objects)
+    {
+        Vec3f lo, hi;
+        o.bounds(lo, hi);
+        detail::appendBoxCorners(Vec3d(lo), Vec3d(hi), pts);
+    }
+    for (const Vec3f& v : extraCorners)
+        pts.push_back(Vec3d(v));
+    map.layout(gl.sun, pts);
+    detail::renderShadowDepth(gl.ctx, map, [&]() {
+        for (const auto& o : gl.objects)
+            o->drawFlat();
+        for (const detail::GlMesh* e : extra)
+            e->drawFlat();
+    });
+    map.finish();
+}
 
 void loadMatrices(const Camera& cam, Size size, double zNear, double zFar)
 {
@@ -712,10 +759,37 @@ void renderPasses(GlScene& gl, const SceneModel& m, const Camera& cam, Size size
             o->draw();
         for (const detail::GlMesh* e : extra)
             e->draw();
+        Mat camZ;
+        if (out.depth || (out.bgr && out.shadow))
+        {
+            Mat d01;
+            gl.ctx.readDepth(d01);
+            detail::windowDepthToCameraZ(cam, d01, zNear, zFar, camZ);
+        }
         if (out.bgr || out.labels || out.virtualCover)
         {
             Mat bgra;
             gl.ctx.readColorAlpha(bgra);
+            if (out.bgr && out.shadow)
+            {
+                // The ambient-only pass over the same depth (the same fragments pass GL_LEQUAL),
+                // then lit and shadowed colours mixed by the sun's visibility (lighting.hpp).
+                glClear(GL_COLOR_BUFFER_BIT);
+                glDepthFunc(GL_LEQUAL);
+                glDepthMask(GL_FALSE);
+                gl.ground->draw(true);
+                for (const auto& o : gl.objects)
+                    o->draw(true);
+                for (const detail::GlMesh* e : extra)
+                    e->draw(true);
+                glDepthMask(GL_TRUE);
+                glDepthFunc(GL_LESS);
+                Mat amb, z32, vis;
+                gl.ctx.readColorAlpha(amb);
+                camZ.convertTo(z32, CV_32F);
+                detail::depthVisibility(cam, z32, *out.shadow, nullptr, vis);
+                detail::applyVisibility(bgra, amb, vis, bgra);
+            }
             if (out.bgr)
                 cv::cvtColor(bgra, *out.bgr, COLOR_BGRA2BGR);
             if (out.virtualCover)
@@ -730,11 +804,7 @@ void renderPasses(GlScene& gl, const SceneModel& m, const Camera& cam, Size size
                 cv::extractChannel(bgra, *out.labels, 3);
         }
         if (out.depth)
-        {
-            Mat d01;
-            gl.ctx.readDepth(d01);
-            detail::windowDepthToCameraZ(cam, d01, zNear, zFar, *out.depth);
-        }
+            camZ.copyTo(*out.depth);
     }
     if (out.whole)
     {
@@ -784,6 +854,7 @@ void renderSupersampled(GlScene& gl, const SceneModel& m, const Camera& cam, Siz
     Mat fine, fineCover;
     PassOutputs colour;
     colour.bgr = &fine;
+    colour.shadow = out.shadow;
     if (out.virtualCover)
         colour.virtualCover = &fineCover;
     renderPasses(gl, m, supersampledCamera(cam, supersample),
@@ -862,6 +933,7 @@ void renderView(GlScene& gl, const SceneModel& m, const Camera& cam, Size size, 
         Mat bgr, cover;
         PassOutputs colour;
         colour.bgr = &bgr;
+        colour.shadow = out.shadow;
         if (out.virtualCover)
             colour.virtualCover = &cover;
         renderSupersampled(gl, m, ideal, idealSize, supersample, extra, extraCorners, colour);
@@ -1189,6 +1261,11 @@ public:
         if (!(std::abs(p.whiteBalanceDrift) < 1.0))
             CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: whiteBalanceDrift must "
                      "be in (-1, 1) (got %g)", p.whiteBalanceDrift));
+        p.sun.validate("SceneSynthesizer: sun");
+        if (p.sun.enabled() && !(p.sun.direction[1] > 0))
+            CV_Error(Error::StsBadArg, cv::format("SceneSynthesizer: the sun must be above the "
+                     "horizon (direction y > 0, the world is y up), got (%g, %g, %g)",
+                     p.sun.direction[0], p.sun.direction[1], p.sun.direction[2]));
         if (!(p.videoBitrateMbps >= 0.0 && p.videoBitrateMbps <= 200.0))
             CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: videoBitrateMbps must "
                      "be in [0, 200] (got %g)", p.videoBitrateMbps));
@@ -1236,6 +1313,7 @@ public:
             out.labels = &scene.labels[f];
             out.depth = &scene.depth[f];
             out.whole = &whole[f];
+            out.shadow = realShadow(gl, m);
             renderView(gl, m, m.cameras[f], p_.imageSize, p_.frameSupersample, {}, {}, out);
             applyGains(scene.frames[f], frameGains(p_, f));
             detail::reportProgress(p_.progress, "synth", "render", f + 1, F, "frames");
@@ -1288,7 +1366,8 @@ public:
         {
             if (vm.vertices.empty())
                 continue;
-            meshes.emplace_back(new detail::GlMesh(vm, 1.f));
+            meshes.emplace_back(gl.sun.enabled() ? new detail::GlMesh(vm, 1.f, gl.light)
+                                                 : new detail::GlMesh(vm, 1.f));
             extra.push_back(meshes.back().get());
             Vec3f a, b;
             vm.bounds(a, b);
@@ -1302,6 +1381,17 @@ public:
         const Vec3d gains = frameGains(p_, frame);
         if (gains != Vec3d(1, 1, 1) && !extra.empty())
             out.virtualCover = &cover;
+        detail::ShadowMap withVirtual;
+        if (gl.sun.enabled())
+        {
+            if (extra.empty())
+                out.shadow = realShadow(gl, m);
+            else
+            {
+                renderSunShadow(gl, m, extra, corners, withVirtual);
+                out.shadow = &withVirtual;
+            }
+        }
         renderView(gl, m, m.cameras[frame], p_.imageSize, supersample, extra, corners, out);
         applyGains(bgr, gains, cover);
         meshes.clear();  // textures deleted while the context is current
@@ -1325,6 +1415,7 @@ public:
             out.depth = &dep;
         if (wholeMasks.needed())
             out.whole = &whole;
+        out.shadow = realShadow(gl, m);
         renderView(gl, m, m.cameras[frame], p_.imageSize, p_.frameSupersample, {}, {}, out);
         applyGains(bgr, frameGains(p_, frame));
         bgr.copyTo(image);
@@ -1380,8 +1471,20 @@ private:
     GlScene& glScene() const
     {
         if (!gl_)
-            gl_.reset(new GlScene(p_.imageSize, model()));
+            gl_.reset(new GlScene(p_.imageSize, model(), p_.sun));
         return *gl_;
+    }
+    // The real objects' shadow map under Params::sun (null without a sun); callers hold mutex_.
+    static const detail::ShadowMap* realShadow(GlScene& gl, const SceneModel& m)
+    {
+        if (!gl.sun.enabled())
+            return nullptr;
+        if (!gl.realShadowReady)
+        {
+            renderSunShadow(gl, m, {}, {}, gl.realShadow);
+            gl.realShadowReady = true;
+        }
+        return &gl.realShadow;
     }
 
     Params p_;

@@ -12,7 +12,33 @@ namespace detail {
 
 Vec3f shadeColor(const Material& material, const Vec3f& normal, const Vec3f& base)
 {
-    const float ndotl = std::max(0.f, normal.dot(kLightDirection));
+    return shadeColor(material, normal, base, kLightDirection);
+}
+
+Vec3f ambientColor(const Material& material, const Vec3f& base)
+{
+    Vec3f c;
+    for (int k = 0; k < 3; k++)
+        c[k] = std::min(1.f, std::max(0.f, base[k] * material.ambient[k]));
+    return c;
+}
+
+Material sunSplitMaterial(const Material& material, double sky)
+{
+    Material m = material;
+    for (int k = 0; k < 3; k++)
+    {
+        const float total = material.ambient[k] + material.diffuse[k];
+        m.ambient[k] = (float)(sky * total);
+        m.diffuse[k] = (float)((1 - sky) * total);
+    }
+    return m;
+}
+
+Vec3f shadeColor(const Material& material, const Vec3f& normal, const Vec3f& base,
+                 const Vec3f& light)
+{
+    const float ndotl = std::max(0.f, normal.dot(light));
     Vec3f c;
     for (int k = 0; k < 3; k++)
         c[k] = std::min(1.f, std::max(0.f, base[k] * (material.ambient[k] +
@@ -59,6 +85,16 @@ unsigned uploadTexture(const Mat& image)
 
 GlMesh::GlMesh(const Mesh& meshIn, float alpha)
 {
+    init(meshIn, alpha, kLightDirection);
+}
+
+GlMesh::GlMesh(const Mesh& meshIn, float alpha, const Vec3f& light)
+{
+    init(meshIn, alpha, light);
+}
+
+void GlMesh::init(const Mesh& meshIn, float alpha, const Vec3f& light)
+{
     const Mesh* mesh = &meshIn;
     Mesh withNormals;
     if (meshIn.normals.size() != meshIn.vertices.size())
@@ -72,15 +108,21 @@ GlMesh::GlMesh(const Mesh& meshIn, float alpha)
     const bool textured = !mesh->material.texture.empty() && mesh->texcoords.size() == n;
     positions_.resize(3 * n);
     colors_.resize(4 * n);
+    ambient_.resize(4 * n);
     for (size_t i = 0; i < n; i++)
     {
         for (int k = 0; k < 3; k++)
             positions_[3 * i + k] = mesh->vertices[i][k];
-        const Vec3f c = shadeColor(mesh->material, mesh->normals[i],
-                                   hasColors ? mesh->colors[i] : Vec3f(1, 1, 1));
+        const Vec3f base = hasColors ? mesh->colors[i] : Vec3f(1, 1, 1);
+        const Vec3f c = shadeColor(mesh->material, mesh->normals[i], base, light);
+        const Vec3f a = ambientColor(mesh->material, base);
         for (int k = 0; k < 3; k++)
+        {
             colors_[4 * i + k] = c[k];
+            ambient_[4 * i + k] = a[k];
+        }
         colors_[4 * i + 3] = alpha;
+        ambient_[4 * i + 3] = alpha;
     }
     indices_.reserve(mesh->faces.size() * 3);
     for (const Vec3i& f : mesh->faces)
@@ -110,7 +152,7 @@ GlMesh::~GlMesh()
     }
 }
 
-void GlMesh::draw() const
+void GlMesh::draw(bool ambientOnly) const
 {
     if (indices_.empty())
         return;
@@ -119,7 +161,7 @@ void GlMesh::draw() const
     glEnableClientState(GL_VERTEX_ARRAY);
     glEnableClientState(GL_COLOR_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, positions_.data());
-    glColorPointer(4, GL_FLOAT, 0, colors_.data());
+    glColorPointer(4, GL_FLOAT, 0, ambientOnly ? ambient_.data() : colors_.data());
     if (texture_)
     {
         glEnable(GL_TEXTURE_2D);

@@ -39,6 +39,16 @@ texture: base * (ambient + diffuse * max(0, n . L)), clamped.
 */
 Vec3f shadeColor(const Material& material, const Vec3f& normal,
                  const Vec3f& base = Vec3f(1, 1, 1));
+//! shadeColor() under another light (a Sun of lighting.hpp): unit vector towards it, world.
+Vec3f shadeColor(const Material& material, const Vec3f& normal, const Vec3f& base,
+                 const Vec3f& light);
+/** @brief The ambient part alone, base * ambient clamped: the colour of a point the light does
+not reach (the shadowed colour of lighting.hpp's model, V = 0). */
+Vec3f ambientColor(const Material& material, const Vec3f& base = Vec3f(1, 1, 1));
+/** @brief The material of a real surface of the footage under a sun with sky share `sky`
+(lighting.hpp): ambient = sky (a + d), diffuse = (1 - sky) (a + d), so that the ambient-only
+colour over the lit colour is the shadow-catcher ratio of the light model. */
+Material sunSplitMaterial(const Material& material, double sky);
 
 /** @brief Uploads `image` as a GL_TEXTURE_2D of the current OpenGL context and returns its name
 (the caller deletes it with glDeleteTextures, in that context).
@@ -66,19 +76,26 @@ public:
     @param alpha alpha written with every fragment (the synthesizer encodes object labels in it).
     */
     explicit GlMesh(const Mesh& mesh, float alpha = 1.f);
+    /** @param mesh the mesh (copied).
+    @param alpha as above.
+    @param light unit vector towards the light (a Sun's direction), world. */
+    GlMesh(const Mesh& mesh, float alpha, const Vec3f& light);
     ~GlMesh();
     GlMesh(const GlMesh&) = delete;
     GlMesh& operator=(const GlMesh&) = delete;
 
-    //! Draws lit and textured. Expects depth test and matrices set by the caller.
-    void draw() const;
+    //! Draws lit and textured (ambientOnly: the ambient colours, ambientColor(): in shadow).
+    //! Expects depth test and matrices set by the caller.
+    void draw(bool ambientOnly = false) const;
     //! Draws geometry only, with the current glColor (no texture, no lighting): masks, IDs.
     void drawFlat() const;
     size_t triangleCount() const { return indices_.size() / 3; }
 
 private:
     std::vector<float> positions_;  // xyz
+    void init(const Mesh& mesh, float alpha, const Vec3f& light);
     std::vector<float> colors_;     // rgba
+    std::vector<float> ambient_;    // rgba, ambient only
     std::vector<float> texcoords_;  // uv (empty without texture)
     std::vector<unsigned> indices_;
     unsigned texture_ = 0;

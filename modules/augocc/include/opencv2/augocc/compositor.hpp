@@ -8,7 +8,9 @@
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/clone_builder.hpp"
+#include "opencv2/augocc/lighting.hpp"
 #include "opencv2/augocc/mesh.hpp"
+#include "opencv2/augocc/scene.hpp"
 
 namespace cv {
 namespace augocc {
@@ -82,6 +84,19 @@ public:
         synthesizer's. For a reconstruction, use the rows (right, up, back) of its
         estimateGround() frame, so that the sun shines from above whatever the world's axes. */
         Matx33d lightRotation = Matx33d::eye();
+        /** The sun (lighting.hpp; resolveSun() makes it from a scene file). Disabled (the
+        default): the fixed light of the shading convention, no shadows. Set: the virtual objects
+        are lit by it (lightRotation is not used) with shadows both ways, in shadow maps
+        rendered in the compositor's OpenGL context: the virtual objects darken the real
+        ground (`ground`) and the clones by the shadow-catcher ratio of the light model, with
+        a soft edge Sun::penumbra wide (percentage-closer filtering); the clones (the
+        overload with a CloneSet) and the virtual objects themselves shade the virtual
+        objects. Through a lens the real ground and the clones are shaded in the frame. */
+        Sun sun;
+        //! The real ground (estimateGround()): receives the virtual objects' shadows.
+        GroundFrame ground;
+        //! Shadows of the virtual objects on the real ground and clones (with a sun).
+        bool shadowCatcher = true;
     };
 
     /** @brief Creates a compositor (the OpenGL context is made on first use).

@@ -50,6 +50,37 @@ CV_EXPORTS CompositeScore scoreComposite(InputArray composite, InputArray truth,
                                          InputArray visibleTruth, InputArray silhouette,
                                          int greyTolerance = 8, int bandRadius = 2);
 
+//! What scoreShadows() found, on one kind of surface (real or virtual).
+struct CV_EXPORTS ShadowScore
+{
+    double fractionWithin = 1;    //!< band pixels whose grey levels agree within tolerance
+    int bandPixels = 0;           //!< pixels where the composite or the truth has a shadow
+    double boundaryDistance = 0;  //!< mean distance (px) between shadow boundaries, symmetric
+    int boundaryPixels = 0;       //!< shadow-boundary pixels of the truth and the composite
+};
+
+/** @brief Compares the shadows of a composite with the ground truth's, on the pixels `mask`
+selects (e.g. the real surfaces: no virtual object in either; or the virtual objects: covered in
+both).
+
+A pixel has a shadow in an image when its grey level differs from the unshadowed reference by
+more than the tolerance; the band is where the composite or the truth has one, and
+fractionWithin the fraction of the band where the two agree within the tolerance. The shadow
+region of an image is where its grey level is below (1 - kShadowDepth) times the reference's;
+boundaryDistance averages, over the boundary pixels of both regions (those more than 2 px from
+the pixels `mask` leaves out), the distance to the other region's boundary (to the other
+image's band pixels where its region has no boundary: a fainter shadow).
+@param reference the unshadowed image (the input frame; for virtual objects, their colour
+without the shadows being scored), BGR CV_8UC3.
+@param composite the composite, BGR CV_8UC3.
+@param truth the ground truth, BGR CV_8UC3.
+@param mask CV_8U, > 0 where scored.
+@param greyTolerance the issue's 8 grey levels. */
+CV_EXPORTS ShadowScore scoreShadows(InputArray reference, InputArray composite, InputArray truth,
+                                    InputArray mask, int greyTolerance = 8);
+//! scoreShadows(): the darkening (fraction of the reference) that marks the shadow region.
+const double kShadowDepth = 0.12;
+
 /** @brief Similarity that maps the world of `rec` onto the world of `reference` (X_ref =
 M * X_rec), estimated from the cameras of the frames both have: rotation from the camera
 rotations, scale from the zooms (or a joint least-squares with the translation for PERSPECTIVE),

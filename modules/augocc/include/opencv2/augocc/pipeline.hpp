@@ -47,6 +47,9 @@ struct CV_EXPORTS CompositeOptions
     double fps = 0;            //!< output video frame rate (0: the input's)
     //! Light frame (Compositor::Params::lightRotation); default: from estimateGround(rec).
     bool lightFromGround = true;
+    /** The scene's sun (resolveSun()): disabled, the fixed light; set, Compositor::Params::sun
+    with the ground of estimateGround(rec) receiving the virtual objects' shadows. */
+    Sun sun;
     ProgressCallback progress; //!< stage "composite": frames written, after every frame
     //! Name of the reconstruction in error messages (its file, when it comes from one).
     String reconstructionName = "reconstruction";
@@ -192,6 +195,10 @@ struct CV_EXPORTS DemoOptions
     model: what augocc did before issue 15, for comparison). */
     int lens = DEMO_LENS_SELF_CALIBRATE;
     bool photoRefine = true;  //!< RunOptions::photoRefine
+    /** The demo scene's sun (demoSun()): the footage is synthesized under it (real shadows)
+    and scene.yml carries it, so the composite has shadows both ways; false: the fixed light
+    of the shading convention and no shadows (the "before" of doc/lighting.md). */
+    bool sun = true;
     //! Progress of the synthesis (stage "synth") and of the run (RunOptions::progress).
     ProgressCallback progress;
 };
@@ -225,7 +232,21 @@ struct CV_EXPORTS DemoResult
     //! The true intrinsics (OpenCV's calibration.yml) of PERSPECTIVE footage written as a data
     //! set (DemoOptions::videoBitrateMbps > 0); else empty.
     String calibrationPath;
+    /** DemoOptions::sun: scoreShadows() of the composite against the synthesizer's truth over
+    the scored frames (band pixels pooled): the virtual objects' shadows on the real surfaces
+    (no virtual object in either image), and the real objects' shadows on the virtual ones
+    (covered in both). fractionWithin and bandPixels pool the frames' bands; boundaryDistance
+    is the mean over the frames with a shadow boundary, boundaryPixels counts those frames.
+    bandPixels 0: no shadow in any frame. */
+    ShadowScore shadowReal, shadowVirtual;
 };
+
+/** @brief The demo scene's sun: azimuth 150 degrees (clockwise from north, north = the mean
+view direction: from behind the camera, on its right), elevation 55 degrees, sky share 0.5,
+penumbra 3 px: the building's shadow falls on the dome, the dome's and the tree's on the ground.
+(Elevation 40 with sky 0.4 left the L-block's inner corner in deep shadow, where the clones
+carved worse: occlusion boundary 5.5 px against 0.4 px; doc/lighting.md.) */
+CV_EXPORTS SceneSun demoSun();
 
 /** @brief The embedded demo: synthesizes a scene, writes its video and key-frame masks, a
 scene.yml with a procedural dome behind the front building and a tree in front of it, runs

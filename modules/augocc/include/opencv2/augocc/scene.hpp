@@ -9,6 +9,7 @@
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/clone_builder.hpp"
 #include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/lighting.hpp"
 #include "opencv2/augocc/mesh.hpp"
 
 /*
@@ -65,11 +66,48 @@ struct CV_EXPORTS SceneObject
     } material;
 };
 
+/** @brief The `sun` node of a scene file, as parsed (resolveSun() turns it into a Sun of the
+reconstruction's world). One of three forms:
+- `direction: [x, y, z]`, towards the sun in the reconstruction's world frame;
+- `azimuth` and `elevation`, degrees: elevation above the reconstruction's ground
+  (estimateGround()), azimuth clockwise from north seen from above (east = 90);
+- `date: "YYYY-MM-DD"`, `time: "HH:MM[:SS]"` (UTC), `latitude`, `longitude` (degrees, north and
+  east positive): solarPosition() gives azimuth and elevation.
+
+North (`north: [x, y, z]`, world frame, its horizontal part): by default the ground frame's
+forward direction `-back`, i.e. the mean view direction: "the camera looks north". For a
+factorization the world frame is the first camera's, so `north: [0, 0, 1]` is straight ahead of
+the first frame. `sky` is Sun::sky; `penumbra` the soft shadow edge in pixels of the first
+camera at the ground origin (resolveSun() converts it to world units). */
+struct CV_EXPORTS SceneSun
+{
+    //! Which form the file gave.
+    enum Form
+    {
+        SUN_NONE = 0,               //!< no `sun` node: no sun, no shadows
+        SUN_DIRECTION = 1,          //!< `direction`
+        SUN_AZIMUTH_ELEVATION = 2,  //!< `azimuth`, `elevation`
+        SUN_DATE_TIME = 3           //!< `date`, `time`, `latitude`, `longitude`
+    };
+    int form = SUN_NONE;                  //!< Form
+    Vec3d direction = Vec3d(0, 0, 0);     //!< SUN_DIRECTION: world frame
+    double azimuthDeg = 0;                //!< SUN_AZIMUTH_ELEVATION (SUN_DATE_TIME: computed)
+    double elevationDeg = 45;             //!< SUN_AZIMUTH_ELEVATION (SUN_DATE_TIME: computed)
+    String date;                          //!< SUN_DATE_TIME: "YYYY-MM-DD"
+    String time;                          //!< SUN_DATE_TIME: "HH:MM[:SS]", UTC
+    double latitudeDeg = 0;               //!< SUN_DATE_TIME
+    double longitudeDeg = 0;              //!< SUN_DATE_TIME
+    Vec3d north = Vec3d(0, 0, 0);         //!< world frame; zero: the ground frame's -back
+    double sky = Sun().sky;               //!< Sun::sky
+    double penumbraPx = 3.0;              //!< soft edge, pixels of the first camera
+};
+
 //! A parsed scene file.
 struct CV_EXPORTS VirtualScene
 {
     String path;                        //!< the file it came from
     std::vector<SceneObject> objects;   //!< the objects, in file order
+    SceneSun sun;                       //!< the `sun` node (form SUN_NONE without one)
 };
 
 /** @brief Reads and validates a scene file; loads its meshes (files relative to the scene file's
@@ -146,6 +184,18 @@ clones are given.
 */
 CV_EXPORTS std::vector<Mesh> placeScene(const VirtualScene& scene, const Reconstruction& rec,
                                         const CloneSet* clones);
+
+/** @brief Direction towards the sun (world frame, unit) from azimuth and elevation relative to a
+ground frame: `cos(el) (cos(az) N + sin(az) E) + sin(el) up`, N the horizontal part of `north`
+(zero: -ground.back), E = N x up (east: clockwise from north seen from above).
+Throws StsBadArg when north is vertical. */
+CV_EXPORTS Vec3d sunDirection(const GroundFrame& ground, double azimuthDeg, double elevationDeg,
+                              const Vec3d& north = Vec3d(0, 0, 0));
+
+/** @brief The scene's sun in the reconstruction's world: direction (SceneSun's forms, ground
+and north from estimateGround(rec)), sky share, and the penumbra converted from pixels of the
+first camera at the ground origin to world units. A disabled Sun when the scene has none. */
+CV_EXPORTS Sun resolveSun(const VirtualScene& scene, const Reconstruction& rec);
 
 //! @brief Model matrix (object to world) of each object, as placeScene() computes it.
 CV_EXPORTS std::vector<Matx44d> scenePoses(const VirtualScene& scene, const Reconstruction& rec,

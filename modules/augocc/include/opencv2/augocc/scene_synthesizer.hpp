@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include "opencv2/augocc/camera.hpp"
 #include "opencv2/augocc/io.hpp"
+#include "opencv2/augocc/lighting.hpp"
 #include "opencv2/augocc/mesh.hpp"
 #include "opencv2/augocc/progress.hpp"
 
@@ -96,6 +97,11 @@ drawer for the compositor): one directional light fixed in the world, towards
 normalize(0.35, 0.8, 0.5) (above, +z and +x side), white; per-vertex colour
 base * (Material::ambient + Material::diffuse * max(0, n . L)) clamped to [0, 1], base = the vertex
 colour or white, multiplied by Material::texture (u right, v up).
+With Params::sun set, the light is that sun instead, with cast shadows (shadow maps, percentage-
+closer filtered: lighting.hpp and doc/lighting.md): the real objects' and the ground's materials
+are split into the sky share and the sun's (ambient = sky (a + d), diffuse = (1 - sky) (a + d)),
+so a real pixel is albedo * (sky + (1 - sky) * V * max(0, n . L)); virtual objects keep their
+own material, colour = base * (ambient + diffuse * V * max(0, n . L)).
 
 Rendering happens on the calling thread with one offscreen OpenGL context owned by the object and
 reused by every call; calls on one object are serialized by a mutex. Each call makes that context
@@ -198,6 +204,10 @@ public:
         `ffmpeg` tool, a phone's 8-16 Mbit/s at 1080p); 0 = OpenCV's VideoWriter with its own
         rate (H.264, else MPEG-4 part 2). */
         double videoBitrateMbps = 0.0;
+        /** The sun (lighting.hpp): disabled (the default), the fixed light above and no
+        shadows; set, its direction (world, y up: direction[1] > 0, above the horizon) lights
+        the scene with cast shadows, the sky share and the penumbra (world units) it holds. */
+        Sun sun;
         //! Progress of synthesize() (stage "synth"): frames rendered.
         ProgressCallback progress;
     };
@@ -222,7 +232,9 @@ public:
     virtual void synthesize(SyntheticScene& scene) const = 0;
 
     /** @brief Renders one frame of the sequence with virtual objects inserted using the true
-    geometry (the compositor's ground truth). Through the lens when the cameras have one (the
+    geometry (the compositor's ground truth). Under Params::sun the virtual objects are
+    rendered as if real: lit by the sun, they cast shadows onto the ground, the real objects and
+    each other, and receive the real objects' shadows (the truth of the compositor's shadows). Through the lens when the cameras have one (the
     distorted frame). With exposure or white-balance drift (Params) the real scene's pixels
     carry the frame's gains and the virtual objects' do not: the truth is what a compositor that
     draws the virtual objects at the nominal exposure onto the filmed frame produces (augocc's
