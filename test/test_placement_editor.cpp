@@ -248,6 +248,49 @@ TEST(Augocc_PlacementEditor, regression_saved_scene_composites_to_preview)
     fs::remove_all(dir);
 }
 
+// Under the scene's sun the preview shows the shadows composite draws (issue 19: "see the
+// composite with occlusion and shadows update live"): still bit-equal to the saved scene's
+// composite, and the sun did change the preview (shadows on the ground and the clones).
+TEST(Augocc_PlacementEditor, regression_preview_under_the_sun)
+{
+    const PlacementShot& shot = placementShot();
+    const std::string dir = tempDir("place_sun");
+    fs::create_directories(dir + "/frames");
+    const int frame = 2;
+    for (size_t f = 0; f < shot.scene.frames.size(); f++)
+        ASSERT_TRUE(imwrite(cv::format("%s/frames/%04d.png", dir.c_str(), (int)f),
+                            shot.scene.frames[f]));
+    VirtualScene sunny = shot.virtualScene;
+    sunny.sun.form = SceneSun::SUN_AZIMUTH_ELEVATION;
+    sunny.sun.azimuthDeg = 150;
+    sunny.sun.elevationDeg = 40;
+    Ptr<PlacementEditor> lit = PlacementEditor::create(shot.scene.groundTruth, shot.clones, sunny);
+    Ptr<PlacementEditor> unlit = makeEditor(shot);
+    Mat withSun, withoutSun;
+    lit->setFrame(frame, shot.scene.frames[frame]);
+    unlit->setFrame(frame, shot.scene.frames[frame]);
+    lit->render(withSun);
+    unlit->render(withoutSun);
+    // A shadow darkens many pixels by tens of grey levels; 3000 is far above the float noise of
+    // one render (0) and far below the shadows' sum.
+    EXPECT_GT(norm(withSun, withoutSun, NORM_L1), 3000.0);
+    const std::string path = dir + "/scene.yml";
+    lit->save(path);
+    const VirtualScene saved = readScene(path);
+    EXPECT_EQ(SceneSun::SUN_AZIMUTH_ELEVATION, saved.sun.form);
+    CompositeOptions opt;
+    opt.firstFrame = frame;
+    opt.endFrame = frame + 1;
+    opt.sun = resolveSun(saved, shot.scene.groundTruth);
+    const std::vector<Mesh> meshes = placeScene(saved, shot.scene.groundTruth, shot.clones.get());
+    compositeSequence(dir + "/frames", shot.scene.groundTruth, *shot.clones, meshes,
+                      dir + "/out", opt);
+    const Mat composited = imread(cv::format("%s/out/%04d.png", dir.c_str(), frame));
+    ASSERT_EQ(withSun.size(), composited.size());
+    EXPECT_EQ(0, norm(withSun, composited, NORM_INF));
+    fs::remove_all(dir);
+}
+
 // The preview and the poses do not depend on the thread count (the Compositor's CPU stages and
 // the editor's bounds).
 TEST(Augocc_PlacementEditor, multithread_reproducibility)

@@ -549,6 +549,9 @@ public:
             cp.supersample = params_.supersample;
             cp.antialiasVirtual = params_.antialiasVirtual;
             cp.lightRotation = ground_.rotation();
+            // Under the scene's sun, shadows both ways as composite draws them (issue 19).
+            cp.ground = ground_;
+            cp.sun = resolveSun(scene_, rec_);
             comp_ = Compositor::create(cp);
             meshesDirty_ = true;
         }
