@@ -119,9 +119,13 @@ testing::AssertionResult sameMattes(const String& a, const String& b)
     return testing::AssertionSuccess();
 }
 
-// The composites decode to the same frames (the same encoder on the same pixels).
+// The composites decode to the same frames within the encoder's own noise: OpenCV 4.6's x264
+// writer is not bit-reproducible in a busy process (doc/pitfalls.md: two encodes of the same
+// frames measured 42-46 dB apart), so every frame must be >= 40 dB PSNR from the other; a
+// wrong composite (another scene or clone) scores about 35 dB or less (test_cli_farm's figures).
 testing::AssertionResult sameVideo(const String& a, const String& b)
 {
+    const double kMinPsnrDb = 40;
     VideoCapture ca(a), cb(b);
     if (!ca.isOpened() || !cb.isOpened())
         return testing::AssertionFailure() << "cannot open " << a << " or " << b;
@@ -134,8 +138,12 @@ testing::AssertionResult sameVideo(const String& a, const String& b)
             return testing::AssertionFailure() << "frame counts differ at " << n;
         if (!ra)
             break;
-        if (fa.size() != fb.size() || cv::norm(fa, fb, NORM_INF) != 0)
-            return testing::AssertionFailure() << "frame " << n << " differs";
+        if (fa.size() != fb.size())
+            return testing::AssertionFailure() << "frame " << n << " sizes differ";
+        const double psnr = cv::PSNR(fa, fb);
+        if (psnr < kMinPsnrDb)
+            return testing::AssertionFailure() << "frame " << n << " differs: " << psnr
+                                               << " dB PSNR";
     }
     if (n == 0)
         return testing::AssertionFailure() << "no frame";
@@ -409,9 +417,11 @@ TEST(Augocc_RunDriver, regression_input_replaced_while_read)
     }
     catch (const cv::Exception& e)
     {
-        // The tracker's own check (FrameSource::checkUnchanged) fires first and names the file;
-        // the manifest's check behind it names the folder.
-        EXPECT_NE(String::npos, e.err.find(frames + "/0010.png was replaced")) << e.err;
+        // Whichever check fires first: the frame source's (FrameSource::checkUnchanged, naming
+        // the file) or the stage manifest's (naming the folder).
+        EXPECT_TRUE(e.err.find(frames + "/0010.png was replaced") != String::npos ||
+                    e.err.find(frames + ": changed while the run read it") != String::npos)
+            << e.err;
     }
     EXPECT_TRUE(replaced) << "the track stage reported no progress to hook";
     EXPECT_FALSE(fs::exists(o.outDir + "/tracks.yml"));

@@ -238,7 +238,9 @@ struct CV_EXPORTS DemoResult
     (covered in both). fractionWithin and bandPixels pool the frames' bands; boundaryDistance
     is the mean over the frames with a shadow boundary, boundaryPixels counts those frames.
     bandPixels 0: no shadow in any frame. */
-    ShadowScore shadowReal, shadowVirtual;
+    ShadowScore shadowReal;
+    //! The real objects' shadows on the virtual ones, scored as shadowReal.
+    ShadowScore shadowVirtual;
 };
 
 /** @brief The demo scene's sun: azimuth 150 degrees (clockwise from north, north = the mean

@@ -62,8 +62,10 @@ struct CV_EXPORTS SceneObject
         bool hasAmbient = false;         //!< `ambient` given
         Vec3f ambient;                   //!< RGB in [0, 1]
         String texture;                  //!< `texture`: the image file (resolved) or empty
+        //! True when the file gave no override.
         bool empty() const { return !hasDiffuse && !hasAmbient && texture.empty(); }
-    } material;
+    };
+    MaterialOverride material;           //!< the file's `material` overrides
 };
 
 /** @brief The `sun` node of a scene file, as parsed (resolveSun() turns it into a Sun of the
