@@ -3,6 +3,7 @@
 // the editor does the tracing, snapping, filling and undo.
 
 #include "cli_common.hpp"
+#include "window_shell.hpp"
 
 #include <cstdlib>
 #include <algorithm>
@@ -103,10 +104,7 @@ public:
                                     frameCount_ - 1));
         frame_ = opt_.frame;
         loadFrame();
-        // Qt aborts the process when it cannot reach a display: say so first.
-        if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY"))
-            throw UsageError("annotate opens a window and needs a display: set DISPLAY (or run "
-                             "it under xvfb-run)");
+        requireDisplay("annotate");
 
         viewport_ = ImageViewport(frameSize_, ImageViewport::fitViewSize(frameSize_, maxView_));
         namedWindow(kWindow, WINDOW_AUTOSIZE | WINDOW_GUI_NORMAL);
@@ -116,8 +114,7 @@ public:
         // Where the frame lies on the screen: tests and scripts driving the window with
         // xdotool read this line, and the view lines (the window pixel at the rectangle's
         // top-left + p shows frame point (p - offset) / scale, ImageViewport).
-        const Rect r = getWindowImageRect(kWindow);
-        info(g_, format("annotate: window image rect %d %d %d %d", r.x, r.y, r.width, r.height));
+        logWindowImageRect(g_, "annotate", kWindow);
         logView();
         bool quit = false;
         while (!quit)
@@ -633,7 +630,7 @@ private:
         if (dragContour_ >= 0 && cursorView_.x >= 0)
             circle(shown, cursorView_, 4, Scalar(0, 0, 255), 1, LINE_AA);
         if (help_)
-            drawHelp(shown);
+            drawHelpOverlay(shown, kHelp, int(sizeof(kHelp) / sizeof(kHelp[0])), 120);
 
         const bool isKey = keyMarks_[objectName()].count(frame_) > 0;
         const bool hasMask = masks_[objectName()].count(frame_) > 0;
@@ -671,24 +668,6 @@ private:
              Scalar(255, 255, 255), 1);
     }
 
-    void drawHelp(Mat view)
-    {
-        const int n = int(sizeof(kHelp) / sizeof(kHelp[0]));
-        const int lineH = 17;
-        const Rect box = Rect(8, 8, std::min(view.cols - 16, 560), n * lineH + 14) &
-                         Rect(Point(), view.size());
-        Mat roi = view(box);
-        Mat dark(roi.size(), roi.type(), Scalar(20, 20, 20));
-        addWeighted(roi, 0.25, dark, 0.75, 0, roi);
-        for (int i = 0; i < n; ++i)
-        {
-            const Point at(box.x + 8, box.y + 18 + i * lineH);
-            putText(view, kHelp[i][0], at, FONT_HERSHEY_SIMPLEX, 0.42, Scalar(150, 220, 255), 1,
-                    LINE_AA);
-            putText(view, kHelp[i][1], at + Point(120, 0), FONT_HERSHEY_SIMPLEX, 0.42,
-                    Scalar(240, 240, 240), 1, LINE_AA);
-        }
-    }
 
     Options opt_;
     const Globals& g_;

@@ -4,6 +4,7 @@
 // previews the composite and saves scene.yml.
 
 #include "cli_common.hpp"
+#include "window_shell.hpp"
 
 #include <cstdlib>
 #include <filesystem>
@@ -61,10 +62,7 @@ public:
     void run()
     {
         load();
-        // Qt aborts the process when it cannot reach a display: say so first.
-        if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY"))
-            throw UsageError("place opens a window and needs a display: set DISPLAY (or run it "
-                             "under xvfb-run)");
+        requireDisplay("place");
         namedWindow(kWindow, WINDOW_AUTOSIZE | WINDOW_GUI_NORMAL);
         setMouseCallback(kWindow, &PlaceApp::onMouse, this);
         if (frames_.size() > 1)
@@ -76,8 +74,7 @@ public:
         waitKey(50);
         // Where the frame lies on the screen: tests and scripts driving the window with xdotool
         // read this line (the image is shown 1:1 from the rectangle's top-left).
-        const Rect r = getWindowImageRect(kWindow);
-        info(g_, format("place: window image rect %d %d %d %d", r.x, r.y, r.width, r.height));
+        logWindowImageRect(g_, "place", kWindow);
         bool quit = false;
         while (!quit)
         {
@@ -361,7 +358,7 @@ private:
         preview.copyTo(view);
         editor_->drawOverlay(view);
         if (help_)
-            drawHelp(view);
+            drawHelpOverlay(view, kHelp, int(sizeof(kHelp) / sizeof(kHelp[0])), 130);
         const int sel = editor_->getSelected();
         std::string what = "no selection";
         if (sel >= 0)
@@ -386,24 +383,6 @@ private:
         imshow(kWindow, canvas_);
     }
 
-    void drawHelp(Mat view)
-    {
-        const int n = int(sizeof(kHelp) / sizeof(kHelp[0]));
-        const int lineH = 17;
-        const Rect box = Rect(8, 8, std::min(view.cols - 16, 560), n * lineH + 14) &
-                         Rect(Point(), view.size());
-        Mat roi = view(box);
-        Mat dark(roi.size(), roi.type(), Scalar(20, 20, 20));
-        addWeighted(roi, 0.25, dark, 0.75, 0, roi);
-        for (int i = 0; i < n; ++i)
-        {
-            const Point at(box.x + 8, box.y + 18 + i * lineH);
-            putText(view, kHelp[i][0], at, FONT_HERSHEY_SIMPLEX, 0.42, Scalar(150, 220, 255), 1,
-                    LINE_AA);
-            putText(view, kHelp[i][1], at + Point(130, 0), FONT_HERSHEY_SIMPLEX, 0.42,
-                    Scalar(240, 240, 240), 1, LINE_AA);
-        }
-    }
 
     Options opt_;
     const Globals& g_;
