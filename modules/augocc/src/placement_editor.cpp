@@ -342,9 +342,7 @@ public:
         Vec3d g;
         if (cur_.selected < 0 || !groundPoint(px, g))
             return false;
-        endDrag();
-        pushUndo();
-        moveBase(cur_.items[cur_.selected], g);
+        moveBase(*beginEdit(), g);
         return true;
     }
 
@@ -352,11 +350,10 @@ public:
     {
         if (!std::isfinite(degrees))
             CV_Error(Error::StsBadArg, "PlacementEditor::rotate: the angle is not finite");
-        if (cur_.selected < 0)
+        Item* edited = beginEdit();
+        if (!edited)
             return false;
-        endDrag();
-        pushUndo();
-        Item& it = cur_.items[cur_.selected];
+        Item& it = *edited;
         const Vec3d c = basePoint(it);
         const Matx33d Ru = rotationFromRodrigues(ground_.up * (degrees * CV_PI / 180.0));
         setAbsolute(it, affine(Ru * linearPart(it.pose), c + Ru * (translationPart(it.pose) - c)));
@@ -371,11 +368,10 @@ public:
         if (!(factor > 0) || !std::isfinite(factor))
             CV_Error(Error::StsBadArg, cv::format("PlacementEditor::scale: factor %g must be "
                                                   "positive", factor));
-        if (cur_.selected < 0)
+        Item* edited = beginEdit();
+        if (!edited)
             return false;
-        endDrag();
-        pushUndo();
-        Item& it = cur_.items[cur_.selected];
+        Item& it = *edited;
         const Vec3d c = basePoint(it);
         setAbsolute(it, affine(linearPart(it.pose) * factor,
                                c + factor * (translationPart(it.pose) - c)));
@@ -386,11 +382,10 @@ public:
     {
         if (!std::isfinite(height))
             CV_Error(Error::StsBadArg, "PlacementEditor::raise: the height is not finite");
-        if (cur_.selected < 0)
+        Item* edited = beginEdit();
+        if (!edited)
             return false;
-        endDrag();
-        pushUndo();
-        Item& it = cur_.items[cur_.selected];
+        Item& it = *edited;
         setAbsolute(it, affine(linearPart(it.pose),
                                translationPart(it.pose) + ground_.up * height));
         return true;
@@ -406,11 +401,10 @@ public:
                                                   ">= 0", gap));
         Vec3d lo, hi;
         getCloneBounds(clone, lo, hi);  // StsObjectNotFound for an unknown clone
-        if (cur_.selected < 0)
+        Item* edited = beginEdit();
+        if (!edited)
             return false;
-        endDrag();
-        pushUndo();
-        Item& it = cur_.items[cur_.selected];
+        Item& it = *edited;
         // scenePoses(): pose = B * eulerDeg(rotation) * diag(scale) * k, B the ground axes as
         // columns; k = 1 without `size`. Keep the object's turn and scale: B^T R, s.
         Matx33d R;
@@ -739,6 +733,17 @@ private:
         cur_.items.push_back(std::move(it));
         cur_.selected = (int)cur_.items.size() - 1;
         return cur_.selected;
+    }
+
+    //! The selected item, ready for an edit: a drag ended, the state before it on the undo
+    //! stack. Null without a selection (nothing pushed).
+    Item* beginEdit()
+    {
+        if (cur_.selected < 0)
+            return nullptr;
+        endDrag();
+        pushUndo();
+        return &cur_.items[cur_.selected];
     }
 
     void pushUndo()
