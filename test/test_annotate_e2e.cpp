@@ -42,15 +42,12 @@ using namespace x11;
 
 TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
 {
-    if (!haveTool("Xvfb") || !haveTool("xdotool"))
-        GTEST_SKIP() << "Xvfb or xdotool not installed (scripts/setup.sh installs xvfb xdotool)";
     const std::string bin = augoccBinary();
-    if (!fs::exists(bin))
-        GTEST_SKIP() << "augocc binary not built: " << bin;
     const char* shotsEnv = std::getenv("AUGOCC_ANNOTATE_SHOTS");
     const std::string shots = shotsEnv ? shotsEnv : "";
-    if (!shots.empty() && !haveTool("ffmpeg"))
-        GTEST_SKIP() << "AUGOCC_ANNOTATE_SHOTS set but ffmpeg missing";
+    const std::string skip = windowTestSkipReason(bin, shots, "AUGOCC_ANNOTATE_SHOTS");
+    if (!skip.empty())
+        GTEST_SKIP() << skip;
 
     // Three frames of the synthesized scene from a slowly turning camera (2 degrees a frame).
     const std::string dir = tempDir("annotate");
@@ -73,17 +70,10 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
     const Mat truth1 = scene.visibleMasks.at("building").at(1);
     const std::string masks = dir + "/masks";
 
-    const int dispNum = freeDisplay();
-    ASSERT_GE(dispNum, 0) << "no free X display number";
-    const std::string display = format(":%d", dispNum);
     Child xvfb;
-    xvfb.pid = spawn({"Xvfb", display, "-screen", "0", "1024x768x24", "-nolisten", "tcp"}, {},
-                     dir + "/xvfb.log");
-    ASSERT_GT(xvfb.pid, 0);
-    const std::string socket = format("/tmp/.X11-unix/X%d", dispNum);
-    for (int i = 0; i < 200 && !fs::exists(socket); ++i)
-        sleepMs(50);
-    ASSERT_TRUE(fs::exists(socket)) << "Xvfb did not start: " << readFile(dir + "/xvfb.log");
+    std::string why;
+    const std::string display = startXvfb(xvfb, dir, why);
+    ASSERT_FALSE(display.empty()) << why;
 
     Child tool;
     const std::string log = dir + "/annotate.log";
@@ -93,28 +83,7 @@ TEST(Augocc_AnnotateE2e, xvfb_xdotool_traces_and_saves_mask)
                      {"DISPLAY=" + display, "QT_QPA_PLATFORM=xcb"}, log);
     ASSERT_GT(tool.pid, 0);
     Rect rect;
-    bool found = false;
-    const auto t0 = std::chrono::steady_clock::now();
-    while (!found && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() <
-                         kStartTimeoutS)
-    {
-        const std::string text = readFile(log);
-        const size_t at = text.find("window image rect ");
-        if (at != std::string::npos && text.find('\n', at) != std::string::npos)
-        {
-            std::istringstream is(text.substr(at + 18));
-            is >> rect.x >> rect.y >> rect.width >> rect.height;
-            found = true;
-        }
-        else
-        {
-            int status;
-            ASSERT_NE(tool.pid, ::waitpid(tool.pid, &status, WNOHANG))
-                << "augocc annotate ended early:\n" << text;
-            sleepMs(100);
-        }
-    }
-    ASSERT_TRUE(found) << "no window within " << kStartTimeoutS << " s:\n" << readFile(log);
+    ASSERT_TRUE(waitForWindowRect(tool, log, kStartTimeoutS, rect, why)) << why;
     // The window shows the frame 1:1 at the top of its image area, status lines below it.
     ASSERT_EQ(size.width, rect.width) << readFile(log);
     ASSERT_GE(rect.height, size.height);
@@ -333,15 +302,12 @@ bool waitForViews(const std::string& log, int count, double timeoutS)
 // the saved mask must equal, pixel for pixel, the library's mask of those frame pixels.
 TEST(Augocc_AnnotateE2e, xvfb_zoomed_1080p_clicks_land_on_frame_pixels)
 {
-    if (!haveTool("Xvfb") || !haveTool("xdotool"))
-        GTEST_SKIP() << "Xvfb or xdotool not installed (scripts/setup.sh installs xvfb xdotool)";
     const std::string bin = augoccBinary();
-    if (!fs::exists(bin))
-        GTEST_SKIP() << "augocc binary not built: " << bin;
     const char* shotsEnv = std::getenv("AUGOCC_ANNOTATE_SHOTS");
     const std::string shots = shotsEnv ? shotsEnv : "";
-    if (!shots.empty() && !haveTool("ffmpeg"))
-        GTEST_SKIP() << "AUGOCC_ANNOTATE_SHOTS set but ffmpeg missing";
+    const std::string skip = windowTestSkipReason(bin, shots, "AUGOCC_ANNOTATE_SHOTS");
+    if (!skip.empty())
+        GTEST_SKIP() << skip;
 
     const std::string dir = tempDir("annotate_zoom");
     fs::create_directories(dir + "/frames");

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sys/wait.h>
 
 namespace opencv_test {
@@ -41,6 +42,13 @@ std::string sharedDataPath(const std::string& relative)
     std::filesystem::path base = env ? env : AUGOCC_SHARED_DATA_PATH;
     std::filesystem::path p = base / relative;
     return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+std::string writeText(const std::string& dir, const std::string& name, const std::string& text)
+{
+    const std::string path = dir + "/" + name;
+    std::ofstream(path) << text;
+    return path;
 }
 
 std::string tempDir(const std::string& tag)

@@ -29,6 +29,9 @@ std::string sharedDataPath(const std::string& relative);
 //! A fresh empty temporary folder for the current test, removed by the caller if wanted.
 std::string tempDir(const std::string& tag);
 
+//! Writes `text` to `dir`/`name` and returns that path.
+std::string writeText(const std::string& dir, const std::string& name, const std::string& text);
+
 //! Path of the built augocc binary.
 std::string augoccBinary();
 //! Runs a shell command, returns its exit status; stdout+stderr are captured into *output.

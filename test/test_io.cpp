@@ -53,14 +53,6 @@ Reconstruction makeReconstruction(CameraModel model)
     return r;
 }
 
-// Writes `text` to a file and returns its path.
-std::string writeText(const std::string& dir, const std::string& name, const std::string& text)
-{
-    const std::string p = dir + "/" + name;
-    std::ofstream(p) << text;
-    return p;
-}
-
 // Expects fn to throw a cv::Exception whose message contains every fragment.
 template <typename Fn>
 void expectErrorMentions(Fn fn, std::initializer_list<std::string> fragments)

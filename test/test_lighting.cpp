@@ -13,13 +13,6 @@ namespace {
 using namespace cv;
 using namespace cv::augocc;
 
-std::string writeText(const std::string& dir, const std::string& name, const std::string& text)
-{
-    const std::string path = dir + "/" + name;
-    std::ofstream(path) << text;
-    return path;
-}
-
 // The sun of the shadow tests: azimuth 150 degrees from north (-z, the default camera's view)
 // through east (+x), elevation 40 degrees: from the front right, shadows go back left.
 Vec3d testSunDirection()

@@ -48,15 +48,12 @@ PlaceFiles writePlaceFiles(const PlacementShot& shot, const std::string& tag)
 
 TEST(Augocc_PlaceE2e, xvfb_xdotool_drags_and_saves_scene)
 {
-    if (!haveTool("Xvfb") || !haveTool("xdotool"))
-        GTEST_SKIP() << "Xvfb or xdotool not installed (scripts/setup.sh installs xvfb xdotool)";
     const std::string bin = augoccBinary();
-    if (!fs::exists(bin))
-        GTEST_SKIP() << "augocc binary not built: " << bin;
     const char* shotsEnv = std::getenv("AUGOCC_PLACE_SHOTS");
     const std::string shots = shotsEnv ? shotsEnv : "";
-    if (!shots.empty() && !haveTool("ffmpeg"))
-        GTEST_SKIP() << "AUGOCC_PLACE_SHOTS set but ffmpeg missing";
+    const std::string skip = windowTestSkipReason(bin, shots, "AUGOCC_PLACE_SHOTS");
+    if (!skip.empty())
+        GTEST_SKIP() << skip;
 
     const PlacementShot& shot = placementShot();
     const PlaceFiles files = writePlaceFiles(shot, "place_e2e");

@@ -11,13 +11,6 @@ namespace {
 using namespace cv;
 using namespace cv::augocc;
 
-std::string writeText(const std::string& dir, const std::string& name, const std::string& text)
-{
-    const std::string path = dir + "/" + name;
-    std::ofstream(path) << text;
-    return path;
-}
-
 TEST(Augocc_Scene, read_write_roundtrip)
 {
     const std::string dir = tempDir("scene_rt");

@@ -207,6 +207,21 @@ inline bool waitForWindowRect(Child& tool, const std::string& log, double timeou
     return false;
 }
 
+/** Why an end-to-end window test cannot run here, empty when it can: Xvfb or xdotool missing,
+the augocc binary `bin` not built, or screenshots asked for (`shots`, the value of the variable
+`shotsVar`) without ffmpeg to grab them. */
+inline std::string windowTestSkipReason(const std::string& bin, const std::string& shots,
+                                        const std::string& shotsVar)
+{
+    if (!haveTool("Xvfb") || !haveTool("xdotool"))
+        return "Xvfb or xdotool not installed (scripts/setup.sh installs xvfb xdotool)";
+    if (!fs::exists(bin))
+        return "augocc binary not built: " + bin;
+    if (!shots.empty() && !haveTool("ffmpeg"))
+        return shotsVar + " set but ffmpeg missing";
+    return std::string();
+}
+
 /** Starts Xvfb on a free display number; waits for its socket.
 @param screen the screen, WIDTHxHEIGHTxDEPTH.
 @return the display (":N"), empty on failure (with the reason in `why`). */
