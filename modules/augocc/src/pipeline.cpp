@@ -442,6 +442,7 @@ RunResult runPipeline(const RunOptions& o)
         r.tracks = first > 0 ? local.shiftedFrames(first, end) : local;
         writeTracks(tracksPath, r.tracks);
         detail::writeManifest(mTrack, tracksPath);
+        r.tracks = readTracks(tracksPath);  // what a resumed run starts from (see sfm below)
     }
     timer.stop("track");
 
@@ -466,6 +467,11 @@ RunResult runPipeline(const RunOptions& o)
         r.reconstruction = recoverCameras(r.tracks, sfm, &r.sfm);
         writeReconstruction(recPath, r.reconstruction);
         detail::writeManifest(mSfm, recPath);
+        // The later stages start from the file, as a resumed run does: the reconstruction in
+        // memory is not the file's to the last bit (a killed and resumed run's composite under
+        // a sun came out 33-38 dB PSNR from the uninterrupted run's, its clones rebuilt from
+        // the file).
+        r.reconstruction = readReconstruction(recPath);
     }
     timer.stop("sfm");
 
