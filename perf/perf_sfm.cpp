@@ -89,6 +89,34 @@ BENCHMARK(Augocc_OrthoCameraRefiner_perspectiveBA)
     ->Name("Augocc_OrthoCameraRefiner/perspective_ba_100x1000")
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Long shots (issue 16, item 3): recoverCameras on 180 and 1800 frames of tracks that live 60
+// frames, about 200 of them alive in every frame, the camera orbiting 50 degrees per 180 frames.
+// Counter ms_per_frame: the 1800-frame figure must stay within 1.5x of the 180-frame one.
+void Augocc_recoverCameras_longShot(benchmark::State& state)
+{
+    const int frames = (int)state.range(0), life = 60, live = 200;
+    opencv_test::SfmProblemParams p;
+    p.frames = frames;
+    p.points = live * frames / life;
+    p.orbitDegrees = 50.0 * frames / 180;
+    p.partialFraction = 1.0;
+    p.missingFraction = 1.0 - (double)life / frames;
+    const opencv_test::SfmProblem pb = opencv_test::makeSfmProblem(p);
+    SfmOptions o;
+    Reconstruction rec;
+    for (auto _ : state)
+    {
+        rec = recoverCameras(pb.tracks, o);
+        benchmark::DoNotOptimize(rec.points.data);
+    }
+    state.counters["ms_per_frame"] = benchmark::Counter(
+        (double)frames * state.iterations() / 1e3,
+        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.counters["cameras"] = (double)rec.cameras.size();
+}
+BENCHMARK(Augocc_recoverCameras_longShot)->Name("Augocc_recoverCameras/long_shot")
+    ->Arg(180)->Arg(1800)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
 } // namespace
 
 namespace {

@@ -157,6 +157,49 @@ TEST(Augocc_CloneBuilder_Photo, multithread_reproducibility)
     }
 }
 
+TEST(Augocc_CloneBuilder_Photo, reads_only_the_frames_it_compares)
+{
+    // Issue 16 (streaming): refine() needs only photoFrames(); given those alone (the others
+    // empty) it carves exactly what it carves with every frame, and it names a missing one.
+    SceneSynthesizer::Params sp;
+    sp.frames = 16;
+    sp.imageSize = Size(240, 180);
+    sp.numKeyFrames = 4;
+    SyntheticScene s;
+    SceneSynthesizer::create(sp)->synthesize(s);
+    CloneBuilder::Params p;
+    p.photo.maxViews = 6;  // fewer than the 16 cameras, so some frames are not compared
+    Ptr<CloneBuilder> b = CloneBuilder::create(p);
+    const std::vector<int> used = b->photoFrames(s.groundTruth);
+    ASSERT_EQ(6u, used.size());
+    EXPECT_EQ(s.groundTruth.cameras.front().frame, used.front());
+    EXPECT_EQ(s.groundTruth.cameras.back().frame, used.back());
+    for (size_t i = 1; i < used.size(); i++)
+        EXPECT_LT(used[i - 1], used[i]);
+    std::vector<Mat> sparse(s.frames.size());
+    for (int f : used)
+        sparse[f] = s.frames[f];
+    Ptr<CloneSet> all = b->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+    Ptr<CloneSet> few = b->build(s.groundTruth, s.keyFrameMasks, &s.tracks);
+    const int64 carvedAll = b->refine(*all, s.groundTruth, s.frames);
+    const int64 carvedFew = b->refine(*few, s.groundTruth, sparse);
+    EXPECT_GT(carvedAll, 0);
+    EXPECT_EQ(carvedAll, carvedFew);
+    for (const String& name : all->objectNames())
+        EXPECT_EQ(all->voxelCount(name), few->voxelCount(name)) << name;
+    sparse[used[3]] = Mat();
+    try
+    {
+        b->refine(*few, s.groundTruth, sparse);
+        ADD_FAILURE() << "no exception for a missing compared frame";
+    }
+    catch (const cv::Exception& e)
+    {
+        EXPECT_NE(std::string::npos, e.msg.find(cv::format("frame %d is empty", used[3])))
+            << e.msg;
+    }
+}
+
 TEST(Augocc_CloneBuilder_Photo, bad_arg)
 {
     const AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, towerAndEll(), 6, 3);

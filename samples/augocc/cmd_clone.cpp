@@ -58,10 +58,14 @@ void runClone(const CloneOptions& o, const Globals& g)
     Tracks tracks;
     if (!o.tracks.empty())
         tracks = readTracks(o.tracks);
+    ProgressPrinter progress(g);
+    p.progress = progress.callback();
+    cv::Ptr<CloneBuilder> builder = CloneBuilder::create(p);
     std::vector<cv::Mat> frames;
     if (!o.input.empty())
     {
-        // Every frame with a camera, for the photo-consistency carving.
+        // The frames the photo-consistency carving compares (at most PhotoParams::maxViews),
+        // read before the build so a bad video fails early; the others are not held.
         cv::Ptr<FrameSource> src = FrameSource::open(o.input);
         if (src->size() != rec.imageSize)
             throw UsageError("--input " + o.input + cv::format(": frames are %dx%d, the "
@@ -72,21 +76,23 @@ void runClone(const CloneOptions& o, const Globals& g)
                 throw UsageError("--input " + o.input + cv::format(": %d frames, but the "
                                  "reconstruction has a camera for frame %d", src->count(),
                                  cam.frame));
+        const std::vector<int> used = builder->photoFrames(rec);
         frames.resize(src->count());
-        for (int f = 0; f < src->count(); f++)
+        size_t next = 0;
+        for (int f = 0; f < src->count() && next < used.size(); f++)
         {
             cv::Mat img;
             if (!src->read(img))
                 throw UsageError("--input " + o.input + cv::format(": frame %d cannot be read",
                                                                    f));
-            if (rec.findCamera(f) >= 0)
+            if (f == used[next])
+            {
                 frames[f] = img;
+                next++;
+            }
         }
         src->checkUnchanged();  // frames of two versions would carve a wrong clone
     }
-    ProgressPrinter progress(g);
-    p.progress = progress.callback();
-    cv::Ptr<CloneBuilder> builder = CloneBuilder::create(p);
     cv::Ptr<CloneSet> clones = builder->build(rec, masks, o.tracks.empty() ? nullptr : &tracks);
     if (!frames.empty())
         builder->refine(*clones, rec, frames);

@@ -27,7 +27,16 @@ void logWindowImageRect(const Globals& g, const std::string& command, const std:
 void drawHelpOverlay(cv::Mat& view, const char* const (*rows)[2], int n, int valueColumn)
 {
     const int lineH = 17;
-    const cv::Rect box = cv::Rect(8, 8, std::min(view.cols - 16, 560), n * lineH + 14) &
+    // As wide as the widest row (a fixed 560 px cut annotate's longest line).
+    int width = 0;
+    for (int i = 0; i < n; ++i)
+    {
+        int base = 0;
+        const cv::Size key = cv::getTextSize(rows[i][0], cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, &base);
+        const cv::Size val = cv::getTextSize(rows[i][1], cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, &base);
+        width = std::max(width, std::max(key.width, valueColumn + val.width));
+    }
+    const cv::Rect box = cv::Rect(8, 8, std::min(view.cols - 16, width + 16), n * lineH + 14) &
                          cv::Rect(cv::Point(), view.size());
     cv::Mat roi = view(box);
     const cv::Mat dark(roi.size(), roi.type(), cv::Scalar(20, 20, 20));

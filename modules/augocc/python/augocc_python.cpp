@@ -697,7 +697,10 @@ PYBIND11_MODULE(augocc, m)
                  return b.refine(clones, rec, fr); },
              py::arg("clones"), py::arg("rec"), py::arg("frames"),
              "Photo-consistency carving over the frames (frames[f] is frame f, None where "
-             "unused); returns the voxels carved.");
+             "unused); returns the voxels carved.")
+        .def("photoFrames", &CloneBuilder::photoFrames, py::arg("rec"),
+             "The frames refine() compares (at most photo.maxViews, evenly spaced); the "
+             "others may be None.");
 
     m.def("renderMattes", [](const CloneSet& clones, const Reconstruction& rec,
                              const py::object& progress) {

@@ -500,17 +500,23 @@ RunResult runPipeline(const RunOptions& o)
         r.clones = builder->build(r.reconstruction, masks, &r.tracks);
         if (o.photoRefine)
         {
-            // Every frame with a camera (the others stay empty; refine() reads only those).
+            // Only the frames refine() compares are held (photoFrames(): at most
+            // PhotoParams::maxViews); the others stay empty, so memory does not grow with the shot.
+            const std::vector<int> used = builder->photoFrames(r.reconstruction);
             std::vector<Mat> frames(end);
             src->seek(first);
-            for (int f = first; f < end; f++)
+            size_t next = 0;
+            for (int f = first; f < end && next < used.size(); f++)
             {
                 Mat img;
                 if (!src->read(img))
                     CV_Error(Error::StsParseError, o.input + cv::format(": frame %d cannot be "
                              "read again for the photo-consistency carving", f));
-                if (r.reconstruction.findCamera(f) >= 0)
+                if (f == used[next])
+                {
                     frames[f] = img;
+                    next++;
+                }
             }
             builder->refine(*r.clones, r.reconstruction, frames);
         }

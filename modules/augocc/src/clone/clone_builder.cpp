@@ -6,6 +6,7 @@
 
 #include "precomp.hpp"
 #include "clone/ideal_space.hpp"
+#include "clone/key_frame_coverage.hpp"
 #include "clone/passes.hpp"
 
 namespace cv {
@@ -82,6 +83,7 @@ public:
                      int frame, InputArray mask) const CV_OVERRIDE;
     int64 refine(CloneSet& clones, const Reconstruction& rec,
                  InputArrayOfArrays frames) const CV_OVERRIDE;
+    std::vector<int> photoFrames(const Reconstruction& rec) const CV_OVERRIDE;
 
 private:
     Params params_;
@@ -226,6 +228,14 @@ void CloneBuilderImpl::addKeyFrame(CloneSet& clones, const Reconstruction& rec,
     passPatches(obj, ctx);  // Step 5
 }
 
+std::vector<int> CloneBuilderImpl::photoFrames(const Reconstruction& rec) const
+{
+    std::vector<int> frames;
+    for (const Camera* cam : evenlySpacedCameras(rec, params_.photo.maxViews))
+        frames.push_back(cam->frame);
+    return frames;
+}
+
 int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
                                InputArrayOfArrays framesArr) const
 {
@@ -238,9 +248,10 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
         CV_Error(Error::StsBadArg, "CloneBuilder::refine: frames must be a vector of images");
     const int nframes = (int)framesArr.total();
     std::vector<Mat> frames(nframes);
-    for (const Camera& cam : rec.cameras)
+    // Only the frames compared are read (the others may be empty: a long shot is streamed).
+    const std::vector<int> used = photoFrames(rec);
+    for (const int f : used)
     {
-        const int f = cam.frame;
         if (f < 0 || f >= nframes)
             CV_Error(Error::StsBadArg, cv::format("CloneBuilder::refine: the reconstruction has a "
                      "camera for frame %d but %d frames are given", f, nframes));
@@ -272,13 +283,9 @@ int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
     const IdealSpace space = makeIdealSpace(rec, "CloneBuilder::refine");
     if (space.active())
     {
-        std::vector<int> used(frames.size(), 0);
-        for (const Camera& cam : rec.cameras)
-            used[cam.frame] = 1;
-        parallel_for_(Range(0, (int)frames.size()), [&](const Range& r) {
-            for (int f = r.start; f < r.end; f++)
-                if (used[f])
-                    frames[f] = space.image(frames[f]);
+        parallel_for_(Range(0, (int)used.size()), [&](const Range& r) {
+            for (int i = r.start; i < r.end; i++)
+                frames[used[i]] = space.image(frames[used[i]]);
         });
     }
     const IdealMasks idealMasks(set, space);

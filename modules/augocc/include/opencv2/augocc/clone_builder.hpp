@@ -279,12 +279,19 @@ public:
     @param clones a set made by build() or CloneSet::load().
     @param rec the reconstruction: cameras of the frames (only frames with a camera are used).
     @param frames the video frames, frames[f] is frame f (BGR CV_8UC3, or CV_8UC1), the
-    reconstruction's image size; there must be one for every camera's frame.
+    reconstruction's image size; only the frames photoFrames() names are read and must be
+    there, the others may be empty (a long shot need not be held in memory).
     @return the number of voxels carved, all objects together.
     Throws StsBadArg / StsBadSize naming the frame for a missing, empty or mis-sized frame.
     */
     virtual int64 refine(CloneSet& clones, const Reconstruction& rec,
                          InputArrayOfArrays frames) const = 0;
+
+    /** @brief The frames refine() compares: at most PhotoParams::maxViews, evenly spaced over
+    the reconstruction's cameras, increasing. A caller streaming a long video decodes these and
+    passes empty images for the rest.
+    @param rec the reconstruction refine() will be given. */
+    virtual std::vector<int> photoFrames(const Reconstruction& rec) const = 0;
 };
 
 /** @brief Renders every object's matte (and optionally depth) in every frame of `rec`.

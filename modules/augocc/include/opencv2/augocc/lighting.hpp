@@ -44,11 +44,11 @@ struct CV_EXPORTS Sun
     double penumbra = 0.1;
     //! Percentage-closer filtering: (2 r + 1)^2 bilinear taps, r = kPcfRadius; the penumbra
     //! spans kPenumbraTexels = 2 r + 1 shadow-map texels.
-    static const int kPcfRadius = 2;
+    static constexpr int kPcfRadius = 2;
     //! Texels across the penumbra (see penumbra).
-    static const int kPenumbraTexels = 2 * kPcfRadius + 1;
+    static constexpr int kPenumbraTexels = 2 * kPcfRadius + 1;
     //! Largest shadow map side, texels; beyond it the texel grows (the penumbra with it).
-    static const int kMaxShadowMapSide = 4096;
+    static constexpr int kMaxShadowMapSide = 4096;
 
     //! True when direction is set (non-zero).
     bool enabled() const { return direction.dot(direction) > 0; }

@@ -127,9 +127,9 @@ public:
         PATH_HANDHELD = 1
     };
     //! Largest frame size: UHD 3840 x 2160 (or 2160 x 3840).
-    static const int kMaxImageWidth = 3840;
+    static constexpr int kMaxImageWidth = 3840;
     //! Largest frame size: the other side.
-    static const int kMaxImageHeight = 2160;
+    static constexpr int kMaxImageHeight = 2160;
     //! PATH_HANDHELD: camera height over the tallest object's height.
     static constexpr double kHandheldHeightFraction = 0.25;
     //! PATH_HANDHELD: peak sway of the camera centre per axis, world units.
@@ -139,9 +139,9 @@ public:
     //! PATH_HANDHELD: peak roll, degrees.
     static constexpr double kHandheldRollDeg = 1.5;
     //! Lens distortion: the finest sampling of labels, depth and masks (see Params::distortion).
-    static const int kLensMaskSupersample = 2;
+    static constexpr int kLensMaskSupersample = 2;
     //! Lens distortion: at most this many samples per label / depth / mask render.
-    static const int kLensMaskPixels = 12 * 1000 * 1000;
+    static constexpr int kLensMaskPixels = 12 * 1000 * 1000;
 
     /** @brief Parameters of the synthesized scene; the defaults are the initializers.
 
