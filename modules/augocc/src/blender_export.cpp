@@ -233,6 +233,8 @@ void writeShot(const String& scriptPath, const Reconstruction& rec, const CloneS
     const ShotData shot = checkShot(rec, options);
     const std::vector<Matx44d> poses = scenePoses(scene, rec, &clones);
     const GroundFrame ground = estimateGround(rec);
+    const Sun sceneSun = resolveSun(scene, rec);
+    const bool sunLit = sceneSun.enabled();
 
     const fs::path script = fs::absolute(scriptPath);
     const fs::path here = script.parent_path();
@@ -271,8 +273,11 @@ void writeShot(const String& scriptPath, const Reconstruction& rec, const CloneS
                     corners.push_back(Vec3d(v[0], v[1], v[2]));
                 const String name = format("%s_%d", scene.objects[i].name.c_str(), (int)k);
                 writeMeshPly((fs::path(tmp) / "objects" / (name + ".ply")).string(), m);
-                const Vec3d col(m.material.diffuse[0], m.material.diffuse[1],
-                                m.material.diffuse[2]);
+                // Under a sun the script's Lambertian albedo: ambient + diffuse (a face lit
+                // head-on, base * (a + d) in shading.hpp); without one the diffuse colour.
+                const Vec3f c = sunLit ? m.material.ambient + m.material.diffuse
+                                       : m.material.diffuse;
+                const Vec3d col(c[0], c[1], c[2]);
                 objectsJson << (n++ ? ",\n  " : "\n  ") << "{\"name\": " << quoted(name)
                             << ", \"object\": " << quoted(scene.objects[i].name)
                             << ", \"file\": " << quoted(assetsName + "/objects/" + name + ".ply")
@@ -382,10 +387,42 @@ void writeShot(const String& scriptPath, const Reconstruction& rec, const CloneS
         groundJson << (k ? ", " : "") << vec(X.val, 3);
     }
     groundJson << "]";
-    // The sun of the shading convention (src/shading.hpp): fixed in the ground frame.
-    const Vec3d L(detail::kLightDirection[0], detail::kLightDirection[1],
-                  detail::kLightDirection[2]);
-    const Vec3d sun = ground.right * L[0] + ground.up * L[1] + ground.back * L[2];
+    // The light. Without a sun in scene.yml: the fixed light of the shading convention
+    // (src/shading.hpp) in the ground frame, as before. With one: resolveSun()'s direction (the
+    // reconstruction's world, as every asset), its sky share and its penumbra as the sun's
+    // angular diameter: augocc's penumbra is a width on the receiver, Blender's grows with the
+    // caster's height above it, so the angle is the penumbra over the mean height of the
+    // virtual objects' vertices above the ground (their shadows' typical caster distance).
+    Vec3d sun;
+    String sunJson = "null";
+    if (sunLit)
+    {
+        sun = sceneSun.direction / cv::norm(sceneSun.direction);
+        double heightSum = 0;
+        size_t count = 0;
+        for (size_t i = 0; i < scene.objects.size(); i++)
+            for (const Mesh& m0 : scene.objects[i].meshes)
+            {
+                Mesh m = m0;
+                m.transform(poses[i]);
+                for (const Vec3f& v : m.vertices)
+                {
+                    heightSum += std::max(0.0, ground.toGround(Vec3d(v[0], v[1], v[2]))[1]);
+                    count++;
+                }
+            }
+        const double meanHeight = count ? heightSum / count : 0;
+        const double angle = meanHeight > 0 ? std::min(sceneSun.penumbra / meanHeight, 0.5) : 0;
+        sunJson = format("{\"sky\": %s, \"angle\": %s, \"penumbra\": %s}",
+                         num(sceneSun.sky).c_str(), num(angle).c_str(),
+                         num(sceneSun.penumbra).c_str());
+    }
+    else
+    {
+        const Vec3d L(detail::kLightDirection[0], detail::kLightDirection[1],
+                      detail::kLightDirection[2]);
+        sun = ground.right * L[0] + ground.up * L[1] + ground.back * L[2];
+    }
 
     std::ostringstream j;
     j << "{\n\"model\": " << (ortho ? "\"ORTHO\"" : "\"PERSP\"") << ",\n\"width\": " << W
@@ -406,7 +443,7 @@ void writeShot(const String& scriptPath, const Reconstruction& rec, const CloneS
       << (options.blendPath.empty() ? String("null")
                                     : quoted(relativeTo(options.blendPath, here)))
       << ",\n\"world_matrix\": " << matrix(Wr, Wt) << ",\n\"ground\": " << groundJson.str()
-      << ",\n\"sun_direction\": " << vec(sun.val, 3) << ",\n\"cameras\": " << camerasJson.str()
+      << ",\n\"sun_direction\": " << vec(sun.val, 3) << ",\n\"sun\": " << sunJson << ",\n\"cameras\": " << camerasJson.str()
       << ",\n\"clones\": " << clonesJson.str() << ",\n\"objects\": " << objectsJson.str()
       << "\n}";
 

@@ -282,19 +282,27 @@ def add_compositor(scene, clip):
 
 def add_clones(scene, world):
     """The real objects' clones as holdouts: the trimmed model always, each key frame's patch
-    voxels in the frames whose patch set holds it. They cast no shadow: the real objects'
-    shadows are in the footage already, and the shadow catcher would add them a second time
-    (Blender 3.4 has no light linking to keep only their shadows on the virtual objects)."""
+    voxels in the frames whose patch set holds it. Without a sun they cast no shadow: the real
+    objects' shadows are in the footage already. Under the scene's sun they cast shadows onto
+    the virtual objects (as augocc's compositor does) and are shadow catchers themselves: Cycles
+    computes a catcher's shadow as the ratio of its light with and without the non-catcher
+    objects, so a clone's own shadow on the ground (in both) does not darken the footage a second
+    time, while the virtual objects' shadows on the clones do (augocc's catcher takes them too)."""
+    sunny = SHOT['sun'] is not None
     frames = range(SHOT['first_frame'], SHOT['end_frame'])
+
+    def as_clone(ob):
+        ob.is_holdout = True
+        ob.visible_shadow = sunny
+        ob.is_shadow_catcher = sunny
+
     for c in SHOT['clones']:
         ob = mesh_object(scene, 'clone_' + c['name'], c['file'], world)
-        ob.is_holdout = True
-        ob.visible_shadow = False
+        as_clone(ob)
         for p in c['patches']:
             po = mesh_object(scene, 'clone_%s_patches_%04d' % (c['name'], p['key_frame']), p['file'],
                              world)
-            po.is_holdout = True
-            po.visible_shadow = False
+            as_clone(po)
             shown = set(p['frames'])
             previous = None
             for f in frames:
@@ -306,23 +314,58 @@ def add_clones(scene, world):
                     previous = hidden
 
 
+def object_material(name, color, color_attribute):
+    """Under the scene's sun a Lambertian (Diffuse BSDF) of albedo `color` (augocc's ambient +
+    diffuse colour, lit by sky and sun as add_ground_and_sun() sets them); without it the
+    Principled BSDF of before."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    r, g, b = (srgb_to_linear(min(1.0, v)) for v in color)
+    if SHOT['sun'] is not None:
+        nodes.remove(nodes['Principled BSDF'])
+        bsdf = nodes.new('ShaderNodeBsdfDiffuse')
+        links.new(bsdf.outputs['BSDF'], nodes['Material Output'].inputs['Surface'])
+        bsdf.inputs['Color'].default_value = (r, g, b, 1)
+    else:
+        bsdf = nodes['Principled BSDF']
+        bsdf.inputs['Base Color'].default_value = (r, g, b, 1)
+        bsdf.inputs['Roughness'].default_value = 0.8
+    if color_attribute:
+        attr = nodes.new('ShaderNodeVertexColor')
+        attr.layer_name = color_attribute
+        color_in = bsdf.inputs['Color'] if SHOT['sun'] is not None else bsdf.inputs['Base Color']
+        if SHOT['sun'] is not None:
+            # albedo = vertex colour * (ambient + diffuse), as augocc's base * (a + d)
+            mix = nodes.new('ShaderNodeMixRGB')
+            mix.blend_type = 'MULTIPLY'
+            mix.inputs['Fac'].default_value = 1.0
+            links.new(attr.outputs['Color'], mix.inputs['Color1'])
+            mix.inputs['Color2'].default_value = (r, g, b, 1)
+            links.new(mix.outputs['Color'], color_in)
+        else:
+            links.new(attr.outputs['Color'], color_in)
+    return mat
+
+
 def add_objects(scene, world):
     for o in SHOT['objects']:
         ob = mesh_object(scene, o['name'], o['file'], world)
-        mat = bpy.data.materials.new(o['name'])
-        mat.use_nodes = True
-        bsdf = mat.node_tree.nodes['Principled BSDF']
-        r, g, b = (srgb_to_linear(v) for v in o['color'])
-        bsdf.inputs['Base Color'].default_value = (r, g, b, 1)
-        bsdf.inputs['Roughness'].default_value = 0.8
-        if ob.data.color_attributes:
-            attr = mat.node_tree.nodes.new('ShaderNodeVertexColor')
-            attr.layer_name = ob.data.color_attributes[0].name
-            mat.node_tree.links.new(attr.outputs['Color'], bsdf.inputs['Base Color'])
-        ob.data.materials.append(mat)
+        attrs = ob.data.color_attributes
+        ob.data.materials.append(object_material(o['name'], o['color'],
+                                                 attrs[0].name if attrs else None))
 
 
 def add_ground_and_sun(scene, world):
+    """The estimated ground as a shadow catcher, and the light. Under the scene's sun
+    (lighting.hpp: a real surface's pixel is rho (s + (1 - s) V max(0, n . L)), s the sky share):
+    a SUN light of strength pi (1 - s) (Cycles: a white Lambertian facing a sun of strength E
+    has radiance E / pi) and a uniform world of radiance s (a white Lambertian under it: s),
+    so that the catcher's ratio with and without the virtual objects is augocc's
+    (s + (1 - s) c V_all) / (s + (1 - s) c V_real) up to the sky the objects hide (ambient
+    occlusion, which augocc's constant sky leaves out). The sun's angular diameter is augocc's
+    penumbra over the virtual objects' mean height above the ground (augocc's penumbra is a
+    width on the receiver). Without a sun: the fixed light of before."""
     me = bpy.data.meshes.new('augocc_ground')
     me.from_pydata([tuple(v) for v in SHOT['ground']], [], [(0, 1, 2, 3)])
     ground = bpy.data.objects.new('augocc_ground', me)
@@ -330,7 +373,6 @@ def add_ground_and_sun(scene, world):
     ground.parent = world
     ground.is_shadow_catcher = True
     sun_data = bpy.data.lights.new('augocc_sun', 'SUN')
-    sun_data.energy = 3.0
     sun = bpy.data.objects.new('augocc_sun', sun_data)
     scene.collection.objects.link(sun)
     sun.parent = world
@@ -338,8 +380,18 @@ def add_ground_and_sun(scene, world):
     sun.rotation_mode = 'QUATERNION'
     sun.rotation_quaternion = mathutils.Vector(SHOT['sun_direction']).to_track_quat('Z', 'Y')
     world_data = bpy.data.worlds.new('augocc_world')
-    world_data.color = (0.3, 0.3, 0.3)  # ambient
     scene.world = world_data
+    if SHOT['sun'] is None:
+        sun_data.energy = 3.0
+        world_data.color = (0.3, 0.3, 0.3)  # ambient
+        return
+    sky = SHOT['sun']['sky']
+    sun_data.energy = np.pi * (1 - sky)
+    sun_data.angle = SHOT['sun']['angle']
+    world_data.color = (sky, sky, sky)
+    world_data.use_nodes = True
+    world_data.node_tree.nodes['Background'].inputs['Color'].default_value = (sky, sky, sky, 1)
+    world_data.node_tree.nodes['Background'].inputs['Strength'].default_value = 1.0
 
 
 def build_shot():
