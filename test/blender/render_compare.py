@@ -5,7 +5,7 @@
 # Under the scene's sun (shadow check, optional): also the shadow the virtual objects cast on the
 # real ground. augocc: the composite's darkening of the footage, 1 - composite / frame; Blender:
 # the shadow catcher's alpha (the shot's compositor lays the render over the footage, so the
-# footage is multiplied by 1 - alpha there). Both thresholded at SHADOW_DARKENING, on the pixels
+# footage is multiplied by 1 - alpha there), 3x3 median filtered. Both thresholded at SHADOW_DARKENING, on the pixels
 # where Blender sees the ground plane (not a clone, a holdout) outside the virtual objects (both
 # visible regions, dilated by 2 px); the masks' IoU must reach MIN_SHADOW_IOU, or, with
 # EXPECT=below, stay under it (a wrong sun must fail the check).
@@ -72,6 +72,12 @@ def alpha(path):
     return rgba(path)[:, :, 3]
 
 
+def median3(a):
+    """3x3 median (edges wrap; the shadows are far from the frame's border)."""
+    shifted = [np.roll(np.roll(a, dy, 0), dx, 1) for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+    return np.median(np.stack(shifted), 0)
+
+
 def dilate(mask, r):
     out = mask.copy()
     for dy in range(-r, r + 1):
@@ -129,7 +135,10 @@ if shadow:
         scene.render.filepath = os.path.join(out_dir, 'shadow_%04d.png' % f)
         bpy.ops.render.render(write_still=True)
         region = seen & ~dilate(visible[f], 2)
-        b = (alpha(scene.render.filepath) > darkening) & region
+        # The penumbra's sampling noise (isolated pixels over the threshold) off by a 3x3
+        # median: without it the IoU measured 0.48 (right sun) vs 0.37 (wrong), with it 0.69
+        # vs 0.51 at darkening 0.3.
+        b = (median3(alpha(scene.render.filepath)) > darkening) & region
         frame = rgba(os.path.join(frames_dir, '%04d.png' % f))[:, :, :3].mean(2)
         comp = rgba(os.path.join(composite_dir, '%04d.png' % f))[:, :, :3].mean(2)
         a = (1 - comp / np.maximum(frame, 1e-3) > darkening) & (frame > 0.05) & region
