@@ -35,7 +35,10 @@ build the shot: the footage as movie clip and camera background (and, in the com
 the render), the camera animated with a keyframe per frame (pose and intrinsics), the clones of
 the real objects as holdout objects (each key frame's patch voxels shown in the frames whose
 patch set holds it, CloneSet::patchFrames()), the estimated ground as a shadow catcher, the
-virtual objects where placeScene() puts them, and the sun of the shading convention.
+virtual objects where placeScene() puts them, and the light: the scene's sun when it has one
+(resolveSun(): its direction, a SUN of strength pi (1 - sky) and a world of radiance sky, the
+penumbra as the sun's angular diameter; the clones then also cast shadows and catch them), the
+fixed light of the shading convention otherwise (doc/blender.md).
 
 Conventions (written in the script too): Blender frame = augocc frame + 1 (Blender numbers clips
 from 1). The shot's objects are children of an empty `augocc_world` whose transform takes the
