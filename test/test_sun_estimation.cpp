@@ -127,5 +127,42 @@ TEST(Augocc_SunEstimation, bad_arg)
                  cv::Exception);
 }
 
+// augocc sun end to end on a written data set (frames, gt/reconstruction.yml) and saved clones:
+// the estimate printed and written as a `sun` node readScene()'s sun parser takes; bad input
+// exits 2.
+TEST(Augocc_SunEstimation, cli_end_to_end)
+{
+    SceneSynthesizer::Params p = sunTestParams();
+    p.frames = 8;
+    p.numKeyFrames = 4;
+    p.imageSize = Size(240, 180);
+    p.sun.direction = sunDirection(GroundFrame(), 200, 40);
+    p.sun.sky = 0.4;
+    SyntheticScene scene;
+    SceneSynthesizer::create(p)->synthesize(scene);
+    const std::string dir = tempDir("sun_cli");
+    writeSyntheticScene(dir + "/data", scene, p);
+    const Ptr<CloneSet> clones =
+        CloneBuilder::create()->build(scene.groundTruth, scene.keyFrameMasks, &scene.tracks);
+    clones->save(dir + "/clones.yml.gz");
+    const std::string args = " sun --input " + dir + "/data/frames --reconstruction " + dir +
+                             "/data/gt/reconstruction.yml --clones " + dir + "/clones.yml.gz";
+    std::string out;
+    ASSERT_EQ(0, runCommand(augoccBinary() + args + " --frames 3 --no-uncertainty --out " +
+                                dir + "/sun.yml", &out)) << out;
+    EXPECT_NE(out.find("elevation"), std::string::npos) << out;
+    FileStorage fs(dir + "/sun.yml", FileStorage::READ);
+    ASSERT_TRUE(fs.isOpened());
+    std::vector<double> d;
+    fs["sun"]["direction"] >> d;
+    ASSERT_EQ(d.size(), 3u);
+    const Vec3d L = cv::normalize(Vec3d(d[0], d[1], d[2]));
+    // 10 degrees: the worst-case bound (here 3 frames at 240x180, no jackknife).
+    EXPECT_LE(std::acos(std::min(1.0, L.dot(p.sun.direction))) * 180 / CV_PI, 10.0) << out;
+    EXPECT_EQ(2, runCommand(augoccBinary() + " sun --input " + dir + "/data/frames "
+                            "--reconstruction " + dir + "/data/gt/reconstruction.yml --clones " +
+                            dir + "/missing.yml.gz"));
+}
+
 } // namespace
 } // namespace opencv_test
