@@ -148,7 +148,7 @@ TEST(Augocc_SunEstimation, cli_end_to_end)
     const std::string args = " sun --input " + dir + "/data/frames --reconstruction " + dir +
                              "/data/gt/reconstruction.yml --clones " + dir + "/clones.yml.gz";
     std::string out;
-    ASSERT_EQ(0, runCommand(augoccBinary() + args + " --frames 3 --no-uncertainty --out " +
+    ASSERT_EQ(0, runCommand(augoccBinary() + args + " --sample-frames 3 --no-uncertainty --out " +
                                 dir + "/sun.yml", &out)) << out;
     EXPECT_NE(out.find("elevation"), std::string::npos) << out;
     FileStorage fs(dir + "/sun.yml", FileStorage::READ);

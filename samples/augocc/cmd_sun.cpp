@@ -99,7 +99,8 @@ void registerSun(CLI::App& app, Globals& g)
     sub->add_option("--reconstruction", o->reconstruction, "reconstruction.yml")->required();
     sub->add_option("--clones", o->clones, "clones file from augocc clone")->required();
     sub->add_option("--out", o->out, "write a scene file with the estimated `sun` block");
-    sub->add_option("--frames", o->frames, "frames used, evenly spaced (default 6)")
+    sub->add_option("--sample-frames", o->frames, "how many frames to use, evenly spaced over the "
+                    "cameras (default 6)")
         ->check(CLI::Range(1, 1000));
     sub->add_option("--side-bins", o->sideBins, "albedo groups per clone side by normal "
                     "azimuth (1: one albedo for all sides)")

@@ -130,7 +130,8 @@ public:
 
     /* Sum of squared log residuals over the samples not in group `skip`, albedos eliminated,
     for sky share `sky`. */
-    double rss(const std::vector<float>& t, double sky, int skip, int* count = nullptr) const
+    double rss(const std::vector<float>& t, double sky, int skip, int* count = nullptr,
+               const std::vector<uchar>* keep = nullptr) const
     {
         std::vector<double> sum(regionCount_, 0.0), sum2(regionCount_, 0.0);
         std::vector<int> n(regionCount_, 0);
@@ -138,7 +139,7 @@ public:
         for (size_t i = 0; i < samples_.size(); i++)
         {
             const Sample& sm = samples_[i];
-            if (skip >= 0 && sm.group == skip)
+            if ((skip >= 0 && sm.group == skip) || (keep && !(*keep)[i]))
                 continue;
             const double d = sm.logI - std::log(s + (1 - s) * t[i]);
             sum[sm.region] += d;
@@ -159,12 +160,13 @@ public:
     }
 
     // Sky share minimising rss() (golden-section search on [0.01, 0.99]).
-    double bestSky(const std::vector<float>& t, int skip, double& best) const
+    double bestSky(const std::vector<float>& t, int skip, double& best,
+                   const std::vector<uchar>* keep = nullptr) const
     {
         double a = 0.01, b = 0.99;
         const double g = (std::sqrt(5.0) - 1) / 2;
         double x1 = b - g * (b - a), x2 = a + g * (b - a);
-        double f1 = rss(t, x1, skip), f2 = rss(t, x2, skip);
+        double f1 = rss(t, x1, skip, nullptr, keep), f2 = rss(t, x2, skip, nullptr, keep);
         while (b - a > 1e-4)
         {
             if (f1 < f2)
@@ -173,7 +175,7 @@ public:
                 x2 = x1;
                 f2 = f1;
                 x1 = b - g * (b - a);
-                f1 = rss(t, x1, skip);
+                f1 = rss(t, x1, skip, nullptr, keep);
             }
             else
             {
@@ -181,12 +183,44 @@ public:
                 x1 = x2;
                 f1 = f2;
                 x2 = a + g * (b - a);
-                f2 = rss(t, x2, skip);
+                f2 = rss(t, x2, skip, nullptr, keep);
             }
         }
         const double x = 0.5 * (a + b);
-        best = rss(t, x, skip);
+        best = rss(t, x, skip, nullptr, keep);
         return x;
+    }
+
+    /* The samples whose residual under (t, sky) lies within k RMS of their group's mean: what
+    the model explains, without the pixels the clones' shadows do not (a visual hull is larger
+    than its object, so its predicted shadow covers some lit ground). */
+    std::vector<uchar> inliers(const std::vector<float>& t, double sky, double k) const
+    {
+        std::vector<double> sum(regionCount_, 0.0), sum2(regionCount_, 0.0);
+        std::vector<int> n(regionCount_, 0);
+        std::vector<double> d(samples_.size());
+        const float s = (float)sky;
+        for (size_t i = 0; i < samples_.size(); i++)
+        {
+            d[i] = samples_[i].logI - std::log(s + (1 - s) * t[i]);
+            sum[samples_[i].region] += d[i];
+            sum2[samples_[i].region] += d[i] * d[i];
+            n[samples_[i].region]++;
+        }
+        double tot = 0;
+        int cnt = 0;
+        for (int r = 0; r < regionCount_; r++)
+            if (n[r] > 0)
+            {
+                tot += std::max(0.0, sum2[r] - sum[r] * sum[r] / n[r]);
+                cnt += n[r];
+                sum[r] /= n[r];
+            }
+        const double lim = k * std::sqrt(tot / std::max(1, cnt));
+        std::vector<uchar> keep(samples_.size());
+        for (size_t i = 0; i < samples_.size(); i++)
+            keep[i] = std::abs(d[i] - sum[samples_[i].region]) <= lim;
+        return keep;
     }
 
 private:
@@ -422,6 +456,8 @@ void checkParams(const SunEstimationParams& p)
                                    "expected");
     if (!(p.coarsePenumbraFraction > 0) || !(p.finePenumbraFraction > 0))
         CV_Error(Error::StsBadArg, "estimateSun: penumbra fractions must be positive");
+    if (!(p.skyInlierSigmas >= 0))
+        CV_Error(Error::StsBadArg, "estimateSun: skyInlierSigmas must be >= 0");
     if (p.jackknifeGroups != 0 && p.jackknifeGroups < 3)
         CV_Error(Error::StsBadArg, "estimateSun: jackknifeGroups must be 0 or >= 3");
 }
@@ -505,6 +541,15 @@ SunEstimate estimateSun(const std::vector<Mat>& frames, const std::vector<int>& 
     SunEstimate e;
     e.direction = best.L;
     e.sky = best.sky;
+    if (params.skyInlierSigmas > 0)
+    {
+        // The sky share again over the samples the fit explains (SunEstimationParams).
+        std::vector<float> t;
+        pr.shading(best.L, finePen, t);
+        const std::vector<uchar> keep = pr.inliers(t, best.sky, params.skyInlierSigmas);
+        double c;
+        e.sky = pr.bestSky(t, -1, c, &keep);
+    }
     azElOf(ground, best.L, e.azimuthDeg, e.elevationDeg);
     {
         std::vector<float> t;
