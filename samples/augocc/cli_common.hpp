@@ -141,6 +141,7 @@ void registerPlace(CLI::App& app, Globals& g);
 void registerPropagate(CLI::App& app, Globals& g);
 void registerJoin(CLI::App& app, Globals& g);
 void registerFarm(CLI::App& app, Globals& g);
+void registerSun(CLI::App& app, Globals& g);
 
 } // namespace augocc_cli
 

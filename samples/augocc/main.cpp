@@ -35,6 +35,7 @@ int main(int argc, char** argv)
     registerRun(app, g);
     registerDemo(app, g);
     registerAnnotate(app, g);
+    registerSun(app, g);
     registerPlace(app, g);
     registerPropagate(app, g);
     registerJoin(app, g);

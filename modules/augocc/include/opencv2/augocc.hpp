@@ -74,5 +74,6 @@ Every type, function and file of the module follows these; headers do not restat
 #include "opencv2/augocc/placement_editor.hpp"
 #include "opencv2/augocc/key_frames.hpp"
 #include "opencv2/augocc/visualization.hpp"
+#include "opencv2/augocc/sun_estimation.hpp"
 
 #endif
