@@ -34,21 +34,6 @@ def run_cli(*args, check=True):
 
 
 
-def _drop_sun(path):
-    """The demo scene carries a sun (issue 19); the Python Compositor binding does not take one
-    yet, so the shot is composited without it on both sides (CLI and Python)."""
-    out, skip = [], False
-    for line in open(path).read().splitlines(True):
-        if line.startswith("sun:"):
-            skip = True
-            continue
-        if skip and (line.startswith(" ") or line.startswith("\t")):
-            continue
-        skip = False
-        out.append(line)
-    with open(path, "w") as f:
-        f.write("".join(out))
-
 @pytest.fixture(scope="session")
 def shot(tmp_path_factory):
     """The synthesized shot on disk and in memory."""
@@ -61,7 +46,6 @@ def shot(tmp_path_factory):
     augocc.writeMasks(str(d / "masks"), scene.keyFrameMasks)
     scene_path = str(d / "scene.yml")
     augocc.writeScene(scene_path, augocc.demoVirtualScene(scene_path))
-    _drop_sun(scene_path)
     return dict(dir=d, synth=synth, scene=scene, pattern=str(d / "frames" / "%04d.png"),
                 masks=str(d / "masks"), scene_path=scene_path)
 

@@ -563,6 +563,7 @@ PYBIND11_MODULE(augocc, m)
     py::class_<VirtualScene>(m, "VirtualScene", "A parsed scene file (scene.yml).")
         .def(py::init<>())
         .def_readwrite("path", &VirtualScene::path)
+        .def_readwrite("sun", &VirtualScene::sun, "the `sun` node (SceneSun)")
         .def_property_readonly("objectNames", [](const VirtualScene& s) {
                                    std::vector<String> n;
                                    for (const SceneObject& o : s.objects)
@@ -824,7 +825,14 @@ PYBIND11_MODULE(augocc, m)
         .def_readwrite("antialiasVirtual", &Compositor::Params::antialiasVirtual)
         .def_readwrite("cullBackFaces", &Compositor::Params::cullBackFaces)
         .def_readwrite("edgeRadius", &Compositor::Params::edgeRadius)
-        .def_readwrite("edgeEps", &Compositor::Params::edgeEps);
+        .def_readwrite("edgeEps", &Compositor::Params::edgeEps)
+        .def_readwrite("sun", &Compositor::Params::sun,
+                       "Sun (resolveSun() of a scene): shading and shadows; disabled: the fixed "
+                       "light")
+        .def_readwrite("ground", &Compositor::Params::ground,
+                       "the real ground (estimateGround()): receives the virtual shadows")
+        .def_readwrite("shadowCatcher", &Compositor::Params::shadowCatcher,
+                       "shadows of the virtual objects on the real ground and clones");
     AUGOCC_MATX_PROP(coP, Compositor::Params, lightRotation, 3, 3, "world to shading frame");
 
     py::class_<Compositor, std::shared_ptr<Compositor>>(m, "Compositor",
@@ -885,6 +893,8 @@ PYBIND11_MODULE(augocc, m)
         .def_readwrite("virtualLayerDir", &CompositeOptions::virtualLayerDir)
         .def_readwrite("fps", &CompositeOptions::fps)
         .def_readwrite("lightFromGround", &CompositeOptions::lightFromGround)
+        .def_readwrite("sun", &CompositeOptions::sun,
+                       "the scene's sun (resolveSun()); the ground is estimateGround(rec)")
         .def_readwrite("reconstructionName", &CompositeOptions::reconstructionName);
     defProgress(cOpt, &CompositeOptions::progress);
     m.def("compositeSequence", [](const String& input, const Reconstruction& rec,
@@ -897,15 +907,132 @@ PYBIND11_MODULE(augocc, m)
           py::arg("output"),
           "Composites a sequence to a video or PNG folder, as `augocc composite` (options "
           "as keywords: firstFrame, endFrame, supersample, mattesDir, progress, ...).");
-    py::class_<GroundFrame>(m, "GroundFrame")
-        .def_readonly("height", &GroundFrame::height)
-        .def_readonly("fromPlane", &GroundFrame::fromPlane)
-        .def_property_readonly("up", [](const GroundFrame& g) {
-                                   return py::make_tuple(g.up[0], g.up[1], g.up[2]); })
+    py::class_<GroundFrame> gF(m, "GroundFrame",
+        "The ground of a reconstruction (scene.hpp): unit axes up, right, back (world frame) "
+        "and the plane up . X == height.");
+    gF.def(py::init<>())
+        .def_readwrite("height", &GroundFrame::height)
+        .def_readwrite("fromPlane", &GroundFrame::fromPlane);
+    AUGOCC_VEC3_PROP(gF, GroundFrame, up, "unit up, world frame");
+    AUGOCC_VEC3_PROP(gF, GroundFrame, right, "unit, horizontal, right of the mean view direction");
+    AUGOCC_VEC3_PROP(gF, GroundFrame, back, "unit, horizontal, towards the viewer");
+    gF.def("toGround", [](const GroundFrame& g, const std::array<double, 3>& X) {
+               const Vec3d v = g.toGround(Vec3d(X[0], X[1], X[2]));
+               return py::make_tuple(v[0], v[1], v[2]); }, py::arg("X"),
+           "World point to ground coordinates (right, up above the ground, back).")
+        .def("fromGround", [](const GroundFrame& g, const std::array<double, 3>& X) {
+               const Vec3d v = g.fromGround(Vec3d(X[0], X[1], X[2]));
+               return py::make_tuple(v[0], v[1], v[2]); }, py::arg("g"),
+           "Ground coordinates to a world point.")
         .def("rotation", [](const GroundFrame& g) { return matxToNumpy<3, 3>(g.rotation()); },
              "Rows (right, up, back): the Compositor's lightRotation that compositeSequence() "
              "and `augocc composite` use (CompositeOptions::lightFromGround).");
     m.def("estimateGround", &estimateGround, py::arg("rec"));
+
+    // ---- the sun (lighting.hpp, scene.hpp, sun_estimation.hpp) ------------------------------
+    py::class_<Sun> sunC(m, "Sun",
+        "A sun and sky (lighting.hpp): direction towards the sun (world frame; zero: no sun), "
+        "sky share of the light in [0, 1), penumbra in world units. Sun(direction=(x, y, z), "
+        "sky=0.4, penumbra=0.1).");
+    sunC.def(py::init([](const py::kwargs& kw) { return paramsFromKwargs<Sun>(kw); }))
+        .def_readwrite("sky", &Sun::sky)
+        .def_readwrite("penumbra", &Sun::penumbra);
+    AUGOCC_VEC3_PROP(sunC, Sun, direction, "towards the sun, world frame (zero: disabled)");
+    sunC.def("enabled", &Sun::enabled)
+        .def("validate", [](const Sun& s, const String& what) { s.validate(what); },
+             py::arg("what") = "Sun", "Raises naming `what` when the sun is not valid.")
+        .def("__repr__", [](const Sun& s) {
+                 return cv::format("augocc.Sun(direction=(%.6g, %.6g, %.6g), sky=%.6g, "
+                                   "penumbra=%.6g)", s.direction[0], s.direction[1],
+                                   s.direction[2], s.sky, s.penumbra); });
+
+    py::class_<SceneSun> sceneSun(m, "SceneSun",
+        "The `sun` node of a scene file as parsed (scene.hpp): form SUN_NONE, SUN_DIRECTION, "
+        "SUN_AZIMUTH_ELEVATION or SUN_DATE_TIME and that form's fields.");
+    sceneSun.def(py::init([](const py::kwargs& kw) { return paramsFromKwargs<SceneSun>(kw); }))
+        .def_readwrite("form", &SceneSun::form)
+        .def_readwrite("azimuthDeg", &SceneSun::azimuthDeg)
+        .def_readwrite("elevationDeg", &SceneSun::elevationDeg)
+        .def_readwrite("date", &SceneSun::date)
+        .def_readwrite("time", &SceneSun::time)
+        .def_readwrite("latitudeDeg", &SceneSun::latitudeDeg)
+        .def_readwrite("longitudeDeg", &SceneSun::longitudeDeg)
+        .def_readwrite("sky", &SceneSun::sky)
+        .def_readwrite("penumbraPx", &SceneSun::penumbraPx);
+    AUGOCC_VEC3_PROP(sceneSun, SceneSun, direction, "SUN_DIRECTION: world frame");
+    AUGOCC_VEC3_PROP(sceneSun, SceneSun, north, "world frame; zero: the ground frame's -back");
+    sceneSun.attr("SUN_NONE") = (int)SceneSun::SUN_NONE;
+    sceneSun.attr("SUN_DIRECTION") = (int)SceneSun::SUN_DIRECTION;
+    sceneSun.attr("SUN_AZIMUTH_ELEVATION") = (int)SceneSun::SUN_AZIMUTH_ELEVATION;
+    sceneSun.attr("SUN_DATE_TIME") = (int)SceneSun::SUN_DATE_TIME;
+    m.def("resolveSun", &resolveSun, py::arg("scene"), py::arg("rec"),
+          "The scene's sun in the reconstruction's world (as `augocc composite` takes it); a "
+          "disabled Sun when the scene has none.");
+    m.def("sunDirection", [](const GroundFrame& g, double az, double el,
+                             const std::array<double, 3>& north) {
+              const Vec3d d = sunDirection(g, az, el, Vec3d(north[0], north[1], north[2]));
+              return py::make_tuple(d[0], d[1], d[2]); },
+          py::arg("ground"), py::arg("azimuthDeg"), py::arg("elevationDeg"),
+          py::arg("north") = std::array<double, 3>{0, 0, 0},
+          "Unit direction towards the sun from azimuth (clockwise from north) and elevation "
+          "relative to a ground frame.");
+    m.def("solarPosition", [](int year, int month, int day, double hourUtc, double lat,
+                              double lon) {
+              double az = 0, el = 0;
+              solarPosition(year, month, day, hourUtc, lat, lon, az, el);
+              return py::make_tuple(az, el); },
+          py::arg("year"), py::arg("month"), py::arg("day"), py::arg("hourUtc"),
+          py::arg("latitudeDeg"), py::arg("longitudeDeg"),
+          "(azimuthDeg, elevationDeg) of the sun (NOAA's solar position).");
+    m.def("demoSun", &demoSun, "The demo scene's sun node.");
+
+    py::class_<SunEstimationParams> sunEstP(m, "SunEstimationParams",
+                                        "Parameters of estimateSun() (sun_estimation.hpp).");
+    sunEstP.def(py::init<>())
+        .def_readwrite("maxSamplesPerFrame", &SunEstimationParams::maxSamplesPerFrame)
+        .def_readwrite("edgeMarginPx", &SunEstimationParams::edgeMarginPx)
+        .def_readwrite("normalStep", &SunEstimationParams::normalStep)
+        .def_readwrite("sideBins", &SunEstimationParams::sideBins)
+        .def_readwrite("coarseStepDeg", &SunEstimationParams::coarseStepDeg)
+        .def_readwrite("finalStepDeg", &SunEstimationParams::finalStepDeg)
+        .def_readwrite("minElevationDeg", &SunEstimationParams::minElevationDeg)
+        .def_readwrite("maxElevationDeg", &SunEstimationParams::maxElevationDeg)
+        .def_readwrite("coarsePenumbraFraction", &SunEstimationParams::coarsePenumbraFraction)
+        .def_readwrite("finePenumbraFraction", &SunEstimationParams::finePenumbraFraction)
+        .def_readwrite("skyInlierSigmas", &SunEstimationParams::skyInlierSigmas)
+        .def_readwrite("jackknifeGroups", &SunEstimationParams::jackknifeGroups);
+    py::class_<SunEstimate> sE(m, "SunEstimate", "What estimateSun() found.");
+    sE.def_readonly("sky", &SunEstimate::sky)
+        .def_readonly("azimuthDeg", &SunEstimate::azimuthDeg)
+        .def_readonly("elevationDeg", &SunEstimate::elevationDeg)
+        .def_readonly("angularSigmaDeg", &SunEstimate::angularSigmaDeg)
+        .def_readonly("skySigma", &SunEstimate::skySigma)
+        .def_readonly("rmsLog", &SunEstimate::rmsLog)
+        .def_readonly("rmsLogNoSun", &SunEstimate::rmsLogNoSun)
+        .def_readonly("groundSamples", &SunEstimate::groundSamples)
+        .def_readonly("cloneSamples", &SunEstimate::cloneSamples)
+        .def_readonly("frames", &SunEstimate::frames)
+        .def_readonly("evaluations", &SunEstimate::evaluations)
+        .def_property_readonly("direction", [](const SunEstimate& e) {
+                                   return py::make_tuple(e.direction[0], e.direction[1],
+                                                         e.direction[2]); },
+                               "unit vector towards the sun, the reconstruction's world frame");
+    m.def("sunEstimationFrames", &sunEstimationFrames, py::arg("rec"), py::arg("maxFrames"),
+          "Up to maxFrames frame numbers evenly spaced over the cameras (as `augocc sun` "
+          "picks them).");
+    m.def("estimateSun", [](const py::sequence& frames, const std::vector<int>& frameNumbers,
+                            const Reconstruction& rec, const CloneSet& clones,
+                            const GroundFrame& ground, const py::kwargs& kw) {
+              const SunEstimationParams p = paramsFromKwargs<SunEstimationParams>(kw);
+              const std::vector<Mat> fr = framesFromPy(frames, "frames");
+              py::gil_scoped_release nogil;
+              return estimateSun(fr, frameNumbers, rec, clones, ground, p); },
+          py::arg("frames"), py::arg("frameNumbers"), py::arg("rec"), py::arg("clones"),
+          py::arg("ground"),
+          "The sun's direction and sky share from frames (BGR uint8, frames[i] is frame "
+          "frameNumbers[i]), as `augocc sun` (SunEstimationParams as keywords).");
+    m.def("toSun", &toSun, py::arg("estimate"), py::arg("penumbra") = Sun().penumbra,
+          "The estimate as a Sun (penumbra in world units).");
     m.def("placeScene", [](const VirtualScene& s, const Reconstruction& rec,
                            const CloneSet* clones) { return placeScene(s, rec, clones); },
           py::arg("scene"), py::arg("rec"), py::arg("clones") = nullptr,
