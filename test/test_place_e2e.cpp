@@ -116,6 +116,13 @@ TEST(Augocc_PlaceE2e, xvfb_xdotool_drags_and_saves_scene)
         grab(display, rect, shots + "/place_snapped.png");
         xdo.key("u");      // and undo that: the saved file has the drag only
     }
+    // The sun keys: on (azimuth 135, elevation 45, the default sky share), turned twice by +5
+    // degrees, raised by 5, the sky share up by 0.05.
+    for (const char* k : {"g", "2", "2", "4", "6"})
+        xdo.key(k);
+    sleepMs(500);
+    if (!shots.empty())
+        grab(display, rect, shots + "/place_sun.png");
     xdo.key("w");          // the tool's own screenshot of its canvas
     xdo.key("q");          // save and quit
     const int rc = tool.wait(kExitTimeoutS);
@@ -124,8 +131,13 @@ TEST(Augocc_PlaceE2e, xvfb_xdotool_drags_and_saves_scene)
     xvfb.stop();
 
     ASSERT_TRUE(fs::exists(out)) << text;
+    const VirtualScene placed = readScene(out);
+    EXPECT_EQ(SceneSun::SUN_AZIMUTH_ELEVATION, placed.sun.form) << text;
+    EXPECT_NEAR(145.0, placed.sun.azimuthDeg, 1e-9);
+    EXPECT_NEAR(50.0, placed.sun.elevationDeg, 1e-9);
+    EXPECT_NEAR(Sun().sky + 0.05, placed.sun.sky, 1e-12);
     Ptr<PlacementEditor> saved = PlacementEditor::create(shot.scene.groundTruth, shot.clones,
-                                                         readScene(out));
+                                                         placed);
     ASSERT_EQ(2, saved->getObjectCount());
     const Vec3d base = saved->getBasePoint(0);
     const double fromHeadless = norm(base - ed->getBasePoint(0));

@@ -41,7 +41,36 @@ struct State
     std::vector<Item> items;
     int selected = -1;
     int id = 0;          // identifies the state for isModified()
+    SceneSun sun;        // the scene's sun (an edit like the objects': undoable)
 };
+
+bool sameSun(const SceneSun& a, const SceneSun& b)
+{
+    return a.form == b.form && a.direction == b.direction && a.azimuthDeg == b.azimuthDeg &&
+           a.elevationDeg == b.elevationDeg && a.date == b.date && a.time == b.time &&
+           a.latitudeDeg == b.latitudeDeg && a.longitudeDeg == b.longitudeDeg &&
+           a.north == b.north && a.sky == b.sky && a.penumbraPx == b.penumbraPx;
+}
+
+// Azimuth (clockwise from north seen from above, [0, 360)) and elevation of a direction in a
+// ground frame: the inverse of sunDirection() (scene.hpp), north's horizontal part (zero: -back).
+void directionAngles(const GroundFrame& g, const Vec3d& d, const Vec3d& north, double& azimuthDeg,
+                     double& elevationDeg)
+{
+    Vec3d n = north == Vec3d(0, 0, 0) ? -g.back : north;
+    n -= g.up * n.dot(g.up);
+    n = normalize(n);
+    const Vec3d e = n.cross(g.up);
+    const Vec3d u = normalize(d);
+    elevationDeg = std::asin(std::max(-1.0, std::min(1.0, u.dot(g.up)))) * 180 / CV_PI;
+    azimuthDeg = std::atan2(u.dot(e), u.dot(n)) * 180 / CV_PI;
+    if (azimuthDeg < 0)
+        azimuthDeg += 360;
+    if (azimuthDeg >= 360)
+        azimuthDeg -= 360;
+}
+
+const double kMinSunElevationDeg = 1, kMaxSunElevationDeg = 89, kMaxSky = 0.95;
 
 Matx44d affine(const Matx33d& A, const Vec3d& t)
 {
@@ -95,6 +124,8 @@ public:
         rec_.validate("reconstruction");
         setParams(params);
         ground_ = estimateGround(rec_);
+        cur_.sun = scene.sun;
+        resolvedSun(cur_.sun);  // a bad sun is reported now
         scene_.objects.clear();
         for (const SceneObject& o : scene.objects)
         {
@@ -276,6 +307,7 @@ public:
     VirtualScene getScene() const CV_OVERRIDE
     {
         VirtualScene s = scene_;
+        s.sun = cur_.sun;
         for (const Item& it : cur_.items)
             s.objects.push_back(withMeshes(it));
         return s;
@@ -491,6 +523,86 @@ public:
         meshesDirty_ = true;
     }
 
+    SceneSun getSun() const CV_OVERRIDE { return cur_.sun; }
+
+    void setSun(const SceneSun& sun) CV_OVERRIDE
+    {
+        resolvedSun(sun);  // throws before anything changes
+        endDrag();
+        pushUndo();
+        cur_.sun = sun;
+    }
+
+    bool getSunAngles(double& azimuthDeg, double& elevationDeg) const CV_OVERRIDE
+    {
+        if (cur_.sun.form == SceneSun::SUN_NONE)
+            return false;
+        if (cur_.sun.form == SceneSun::SUN_AZIMUTH_ELEVATION)
+        {
+            azimuthDeg = cur_.sun.azimuthDeg;
+            elevationDeg = cur_.sun.elevationDeg;
+            return true;
+        }
+        directionAngles(ground_, resolvedSun(cur_.sun).direction, cur_.sun.north, azimuthDeg,
+                        elevationDeg);
+        return true;
+    }
+
+    bool turnSun(double dAzimuthDeg, double dElevationDeg) CV_OVERRIDE
+    {
+        if (!std::isfinite(dAzimuthDeg) || !std::isfinite(dElevationDeg))
+            CV_Error(Error::StsBadArg, "PlacementEditor::turnSun: the angles must be finite");
+        double az, el;
+        if (!getSunAngles(az, el))
+            return false;
+        SceneSun s = cur_.sun;
+        s.form = SceneSun::SUN_AZIMUTH_ELEVATION;
+        s.azimuthDeg = std::fmod(az + dAzimuthDeg, 360.0);
+        if (s.azimuthDeg < 0)
+            s.azimuthDeg += 360;
+        s.elevationDeg = std::max(kMinSunElevationDeg,
+                                  std::min(kMaxSunElevationDeg, el + dElevationDeg));
+        s.direction = Vec3d(0, 0, 0);
+        s.date.clear();
+        s.time.clear();
+        setSun(s);
+        return true;
+    }
+
+    bool changeSky(double delta) CV_OVERRIDE
+    {
+        if (!std::isfinite(delta))
+            CV_Error(Error::StsBadArg, "PlacementEditor::changeSky: delta must be finite");
+        if (cur_.sun.form == SceneSun::SUN_NONE)
+            return false;
+        SceneSun s = cur_.sun;
+        s.sky = std::max(0.0, std::min(kMaxSky, s.sky + delta));
+        setSun(s);
+        return true;
+    }
+
+    SunEstimate estimateSunFromFrames(const std::vector<Mat>& frames,
+                                      const std::vector<int>& frameNumbers,
+                                      const SunEstimationParams& params) CV_OVERRIDE
+    {
+        const SunEstimate e = cv::augocc::estimateSun(frames, frameNumbers, rec_, *clones_,
+                                                      ground_, params);
+        SceneSun s = cur_.sun.form == SceneSun::SUN_NONE ? SceneSun() : cur_.sun;
+        s.form = SceneSun::SUN_AZIMUTH_ELEVATION;
+        directionAngles(ground_, e.direction, s.north, s.azimuthDeg, s.elevationDeg);
+        s.elevationDeg = std::max(kMinSunElevationDeg, std::min(kMaxSunElevationDeg,
+                                                                s.elevationDeg));
+        s.sky = std::max(0.0, std::min(kMaxSky, e.sky));
+        s.direction = Vec3d(0, 0, 0);
+        s.date.clear();
+        s.time.clear();
+        setSun(s);
+        estimate_ = e;
+        return e;
+    }
+
+    SunEstimate getSunEstimate() const CV_OVERRIDE { return estimate_; }
+
     bool undo() CV_OVERRIDE
     {
         endDrag();
@@ -526,6 +638,7 @@ public:
                      "needs at least one)");
         // writeScene() references the meshes by file; it does not need them.
         VirtualScene s = scene_;
+        s.sun = cur_.sun;
         for (const Item& it : cur_.items)
             s.objects.push_back(it.so);
         s.path = path;
@@ -545,9 +658,17 @@ public:
             cp.lightRotation = ground_.rotation();
             // Under the scene's sun, shadows both ways as composite draws them (issue 19).
             cp.ground = ground_;
-            cp.sun = resolveSun(scene_, rec_);
+            cp.sun = resolvedSun(cur_.sun);
             comp_ = Compositor::create(cp);
+            compSun_ = cur_.sun;
             meshesDirty_ = true;
+        }
+        else if (!sameSun(compSun_, cur_.sun))
+        {
+            Compositor::Params cp = comp_->getParams();
+            cp.sun = resolvedSun(cur_.sun);
+            comp_->setParams(cp);
+            compSun_ = cur_.sun;
         }
         if (meshesDirty_)
         {
@@ -593,6 +714,18 @@ public:
     }
 
 private:
+    //! The sun of the scene with `sun` in the reconstruction's world (resolveSun()), validated.
+    Sun resolvedSun(const SceneSun& sun) const
+    {
+        VirtualScene s;
+        s.path = scene_.path;
+        s.sun = sun;
+        const Sun r = resolveSun(s, rec_);
+        if (r.enabled())
+            r.validate("PlacementEditor: sun");
+        return r;
+    }
+
     void requireFrame() const
     {
         if (frame_ < 0)
@@ -771,6 +904,8 @@ private:
     Vec3d dragOffset_;
     bool dragging_ = false, dragMoved_ = false, meshesDirty_ = true;
     Ptr<Compositor> comp_;
+    SceneSun compSun_;     // the sun comp_ is lit by
+    SunEstimate estimate_;
 };
 
 } // namespace

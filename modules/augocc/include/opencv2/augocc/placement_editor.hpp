@@ -10,6 +10,7 @@
 #include "opencv2/augocc/compositor.hpp"
 #include "opencv2/augocc/io.hpp"
 #include "opencv2/augocc/scene.hpp"
+#include "opencv2/augocc/sun_estimation.hpp"
 
 namespace cv {
 namespace augocc {
@@ -19,7 +20,9 @@ namespace augocc {
 
 /** @brief Interactive placement of the virtual objects of a scene file over the frames of a shot:
 pick, drag on the estimated ground, turn about the vertical, scale, raise, snap against a clone's
-face, add an object from a mesh file, undo and redo, preview the composite, save scene.yml.
+face, add an object from a mesh file, light the scene: estimate the sun from the footage
+(estimateSun()), turn it and change its sky share; undo and redo, preview the composite, save
+scene.yml.
 
 The paper's users placed the virtual objects "interactively through a GUI" @cite Ong1998. All
 the logic lives here, headless, so that it is tested without a window; `augocc place` only
@@ -190,6 +193,44 @@ public:
     virtual int addShape(const String& shape, Point2d px) = 0;
     //! Removes an object (undoable); StsOutOfRange for a bad index.
     virtual void removeObject(int index) = 0;
+
+    /** @brief The scene's sun as save() writes it (form SceneSun::SUN_NONE: no sun, the
+    preview is lit by the fixed light and casts no shadow). */
+    virtual SceneSun getSun() const = 0;
+    /** @brief Sets the scene's sun (undoable); the preview is lit by it from the next render().
+    @param sun any SceneSun form (SUN_NONE removes the sun); StsBadArg, and nothing changes, when
+    resolveSun() or Sun::validate() rejects it (a sky share outside [0, 1), a bad date...). */
+    virtual void setSun(const SceneSun& sun) = 0;
+    /** @brief The sun's azimuth (degrees clockwise from north seen from above, [0, 360)) and
+    elevation (degrees above the ground) in the editor's ground frame, north the sun's own
+    SceneSun::north (zero: -GroundFrame::back, the mean view direction), whatever its form.
+    @return false when the scene has no sun. */
+    virtual bool getSunAngles(double& azimuthDeg, double& elevationDeg) const = 0;
+    /** @brief Turns the sun (undoable): it becomes the azimuth / elevation form at the current
+    angles plus the given ones, north, sky and penumbra kept; the elevation is held in [1, 89]
+    degrees (a sun at the horizon or the zenith casts no useful shadow).
+    @param dAzimuthDeg degrees, clockwise seen from above.
+    @param dElevationDeg degrees, up.
+    @return false, nothing changed, when the scene has no sun. */
+    virtual bool turnSun(double dAzimuthDeg, double dElevationDeg) = 0;
+    /** @brief Changes the sun's sky share by `delta`, held in [0, 0.95] (undoable).
+    @return false, nothing changed, when the scene has no sun. */
+    virtual bool changeSky(double delta) = 0;
+    /** @brief Estimates the sun from frames of the footage (estimateSun() with the editor's
+    reconstruction, clones and ground) and makes it the scene's sun (undoable): the azimuth /
+    elevation form at the estimate's angles relative to the current sun's north, the estimate's
+    sky share (held in [0, 0.95]), the current penumbra (SceneSun's default without a sun).
+    @param frames BGR (or grey) CV_8U frames `frameNumbers` (sunEstimationFrames() picks them).
+    @param frameNumbers their frame numbers (each with a camera).
+    @param params estimateSun()'s parameters.
+    @return the estimate, its uncertainty included; getSunEstimate() keeps it for display.
+    Throws as estimateSun() does (nothing changes then). */
+    virtual SunEstimate estimateSunFromFrames(const std::vector<Mat>& frames,
+                                              const std::vector<int>& frameNumbers,
+                                              const SunEstimationParams& params =
+                                                  SunEstimationParams()) = 0;
+    //! The last estimateSunFromFrames() result (SunEstimate::frames is 0 before the first).
+    virtual SunEstimate getSunEstimate() const = 0;
 
     //! Undoes the last edit; false when there is nothing to undo.
     virtual bool undo() = 0;
