@@ -127,6 +127,10 @@ const bool kLongShotRegistered = [] {
     const char* longRuns = std::getenv("AUGOCC_PERF_LONG");
     if (longRuns && std::string(longRuns) == "1")
         b->Arg(1800);
+    // AUGOCC_PERF_LONG_FRAMES=N adds an N-frame case (the scaling between 180 and 1800).
+    const char* frames = std::getenv("AUGOCC_PERF_LONG_FRAMES");
+    if (frames && std::atoi(frames) > 0)
+        b->Arg(std::atoi(frames));
     b->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
     return true;
 }();
