@@ -62,10 +62,16 @@ SfmProblem makeSfmProblem(const SfmProblemParams& prm)
                                    ? std::min(0.9, prm.missingFraction * P / nPartial) : 0.5;
     for (int p = 0; p < nPartial; p++)
     {
-        // Length uniform around (1 - meanMissing) F, at least 3 frames.
-        const double frac = std::min(1.0, std::max(0.05, rng.uniform(0.5, 1.5) *
-                                                             (1.0 - meanMissing)));
-        const int len = std::max(3, std::min(F, cvRound(frac * F)));
+        // Length uniform around (1 - meanMissing) F (or trackFrames), at least 3 frames.
+        int len;
+        if (prm.trackFrames > 0)
+            len = std::max(3, std::min(F, cvRound(rng.uniform(0.5, 1.5) * prm.trackFrames)));
+        else
+        {
+            const double frac = std::min(1.0, std::max(0.05, rng.uniform(0.5, 1.5) *
+                                                                 (1.0 - meanMissing)));
+            len = std::max(3, std::min(F, cvRound(frac * F)));
+        }
         start[p] = rng.uniform(0, F - len + 1);
         end[p] = start[p] + len;
     }

@@ -32,6 +32,9 @@ struct SfmProblemParams
     double outlierFraction = 0;      //!< tracks that are not a 3D point (gross outliers)
     double missingFraction = 0;      //!< if > 0, partial tracks are sized so that about this
                                      //!< fraction of the whole matrix is missing
+    int trackFrames = 0;             //!< if > 0, partial tracks last this many frames on
+                                     //!< average (uniform in 0.5-1.5 times it, at least 3),
+                                     //!< whatever the length of the shot; missingFraction unused
     uint64 seed = 1;
 };
 
