@@ -257,9 +257,9 @@ private:
         try
         {
             const SunEstimate e = editor_->estimateSunFromFrames(images, frames);
-            status_ = format("sun estimated from %d frames: azimuth %.1f, elevation %.1f, "
-                             "1-sigma %.1f deg, sky %.2f +- %.2f", e.frames, e.azimuthDeg,
-                             e.elevationDeg, e.angularSigmaDeg, e.sky, e.skySigma);
+            status_ = format("sun estimated from %d frames: az %.1f, el %.1f, 1-sigma %.1f "
+                             "deg, sky %.2f +- %.2f", e.frames, e.azimuthDeg, e.elevationDeg,
+                             e.angularSigmaDeg, e.sky, e.skySigma);
         }
         catch (const cv::Exception& ex)
         {
@@ -304,11 +304,11 @@ private:
         double az, el;
         if (!editor_->getSunAngles(az, el))
             return "no sun (fixed light)   e: estimate it   g: sun on";
-        std::string s = format("sun azimuth %.1f  elevation %.1f  sky %.2f", az, el,
-                               editor_->getSun().sky);
+        // Short enough for a 640-pixel frame (about 85 characters at this font size).
+        std::string s = format("sun az %.1f el %.1f sky %.2f", az, el, editor_->getSun().sky);
         const SunEstimate e = editor_->getSunEstimate();
         if (e.frames > 0)
-            s += format("   (estimate %.1f / %.1f +- %.1f deg, sky %.2f +- %.2f)", e.azimuthDeg,
+            s += format("   estimate %.1f / %.1f +-%.1f deg, sky %.2f +-%.2f", e.azimuthDeg,
                         e.elevationDeg, e.angularSigmaDeg, e.sky, e.skySigma);
         return s;
     }
