@@ -241,7 +241,8 @@ public:
         UnobservedParams unobserved;  //!< build(), after the free space
         PhotoParams photo;            //!< refine()
         /** Progress (stage "clone"): build() reports step "build", a unit per pass and
-        object; refine() step "photo-consistency", a unit per object and round. */
+        object (buildPart() and mergeParts() the same step, for the passes each runs); refine()
+        step "photo-consistency", a unit per object and round. */
         ProgressCallback progress;
     };
 
