@@ -337,11 +337,8 @@ Ptr<CloneSet> CloneBuilderImpl::mergeParts(const std::vector<Ptr<CloneSet> >& pa
     if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
         CV_Error(Error::StsBadSize, "CloneBuilder::mergeParts: the reconstruction has no image "
                  "size");
-    ObjectMasks bins;
-    for (const auto& o : keyFrameMasks)
-        for (const auto& fm : o.second)
-            bins[o.first][fm.first] = fm.second;
-    const PartInfo expected = partInfoOf(rec, bins, tracks, params_);
+    // The parts hold their objects' silhouettes: the masks given here are only fingerprinted.
+    const PartInfo expected = partInfoOf(rec, keyFrameMasks, tracks, params_);
     // The parts are copied (the caller keeps them); the copies' objects move into the merge.
     std::vector<CloneSetImpl> copies;
     copies.reserve(parts.size());
