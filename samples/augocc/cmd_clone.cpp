@@ -178,8 +178,8 @@ void registerClone(CLI::App& app, Globals& g)
     sub->add_option("--object", o->objects, "build only this object (repeatable): writes a "
                     "partial clones file of the passes that need no other object's clone, for "
                     "clone --merge (doc/farm.md)");
-    sub->add_option("--merge", o->merge, "partial clones files written by clone --object, one "
-                    "per object (together every object of --masks): merges them and runs the "
+    sub->add_option("--merge", o->merge, "partial clones files written by clone --object "
+                    "(together every object of --masks, each once): merges them and runs the "
                     "passes that look at every object; the other flags as for the parts");
     sub->callback([o, &g]() { runClone(*o, g); });
 }
