@@ -62,7 +62,8 @@ done
     awk '/^# submission/ {p = 1} /^# ==> / {p = 0} p' "$T/printed.txt"
 } >"$T/submit.sh"
 shellcheck "$T/submit.sh" || fail "the printed sbatch calls are not shellcheck-clean"
-grep -qF -- "--dependency=afterok:\"\$shot_a_1\"" "$T/submit.sh" || fail "the merge does not wait for the clone array"
+grep -qF -- "--dependency=afterok:\"\$shot_a_1\"" "$T/submit.sh" ||
+    fail "the merge does not wait for the clone array"
 grep -qF -- "--dependency=afterok:\"\$shot_a_3\"" "$T/submit.sh" || fail "the join does not wait for the chunks"
 grep -q "shot_c" "$T/out/shot_c/farm/5-join.sh" || fail "shot_c's join names another shot"
 if grep -q "composite" "$T/out/shot_c/farm/4-chunks.sh"; then
