@@ -137,6 +137,7 @@ Plan demoPlan(const std::string& outDir, bool scene)
     p.frameCount = 16;
     p.fps = 29.97;
     p.chunks = splitFrames(16, 0, 4);
+    p.objects = {"building", "l block", "tower"};
     return p;
 }
 
@@ -148,9 +149,12 @@ TEST(Augocc_Farm, scripts)
     o.augocc = "/opt/augocc/bin/augocc";
     o.setup = {"module load opencv/4.6"};
     const std::vector<Script> s = makeScripts(demoPlan("/farm/out/shot1", true), o);
-    ASSERT_EQ(s.size(), 4u);
+    ASSERT_EQ(s.size(), 5u);
     EXPECT_EQ(s[0].file, "1-sfm.sh");
-    EXPECT_EQ(s[3].file, "4-join.sh");
+    EXPECT_EQ(s[1].file, "2-clone.sh");
+    EXPECT_EQ(s[2].file, "3-merge.sh");
+    EXPECT_EQ(s[3].file, "4-chunks.sh");
+    EXPECT_EQ(s[4].file, "5-join.sh");
     for (const Script& x : s)
     {
         EXPECT_EQ(x.text.rfind("#!/bin/bash\n", 0), 0u);
@@ -164,22 +168,34 @@ TEST(Augocc_Farm, scripts)
                   std::string::npos);
     }
     EXPECT_NE(s[0].text.find("#SBATCH --job-name=augocc-shot1-sfm\n"), std::string::npos);
-    EXPECT_NE(s[2].text.find("#SBATCH --array=0-3\n"), std::string::npos);
-    EXPECT_NE(s[2].text.find("FIRST=(0 4 8 12)\nEND=(4 8 12 16)\n"), std::string::npos);
-    EXPECT_NE(s[2].text.find("SCENE='/data/shot 1/scene.yml'\n"), std::string::npos);
-    EXPECT_NE(s[2].text.find(" composite "), std::string::npos);
-    EXPECT_NE(s[3].text.find("chunks/0012-0016/composite"), std::string::npos);
-    EXPECT_NE(s[3].text.find("--fps 29.969999999999999 --out composite.mp4"),
+    // The clones: an array over the objects, each task writing its part; then one merge.
+    EXPECT_NE(s[1].text.find("#SBATCH --job-name=augocc-shot1-clone\n"), std::string::npos);
+    EXPECT_NE(s[1].text.find("#SBATCH --array=0-2\n"), std::string::npos);
+    EXPECT_NE(s[1].text.find("OBJECTS=(building 'l block' tower)\n"), std::string::npos);
+    EXPECT_NE(s[1].text.find("--object \"${OBJECTS[i]}\" --out \"$part\""), std::string::npos);
+    EXPECT_NE(s[1].text.find("if [ -f \"$part\" ]; then"), std::string::npos);
+    EXPECT_EQ(s[1].text.find("--input"), std::string::npos);  // photo refine: at the merge
+    EXPECT_NE(s[2].text.find("#SBATCH --job-name=augocc-shot1-merge\n"), std::string::npos);
+    EXPECT_EQ(s[2].text.find("--array"), std::string::npos);
+    EXPECT_NE(s[2].text.find("--merge \\\n        clones.parts/building.yml.gz \\\n        "
+                             "'clones.parts/l block.yml.gz' \\\n        "
+                             "clones.parts/tower.yml.gz\n"), std::string::npos) << s[2].text;
+    EXPECT_NE(s[2].text.find("--input \"$INPUT\""), std::string::npos);  // photo refine
+    EXPECT_NE(s[3].text.find("#SBATCH --array=0-3\n"), std::string::npos);
+    EXPECT_NE(s[3].text.find("FIRST=(0 4 8 12)\nEND=(4 8 12 16)\n"), std::string::npos);
+    EXPECT_NE(s[3].text.find("SCENE='/data/shot 1/scene.yml'\n"), std::string::npos);
+    EXPECT_NE(s[3].text.find(" composite "), std::string::npos);
+    EXPECT_NE(s[4].text.find("chunks/0012-0016/composite"), std::string::npos);
+    EXPECT_NE(s[4].text.find("--fps 29.969999999999999 --out composite.mp4"),
               std::string::npos);
-    EXPECT_NE(s[1].text.find("--input \"$INPUT\""), std::string::npos);  // photo refine
 
     // No scene: the chunks render mattes, the join has no video.
     o.photoRefine = false;
     const std::vector<Script> m = makeScripts(demoPlan("/farm/out/shot1", false), o);
-    EXPECT_NE(m[2].text.find(" matte "), std::string::npos);
-    EXPECT_EQ(m[2].text.find(" composite "), std::string::npos);
-    EXPECT_EQ(m[3].text.find("composite.mp4"), std::string::npos);
-    EXPECT_EQ(m[1].text.find("--input"), std::string::npos);
+    EXPECT_NE(m[3].text.find(" matte "), std::string::npos);
+    EXPECT_EQ(m[3].text.find(" composite "), std::string::npos);
+    EXPECT_EQ(m[4].text.find("composite.mp4"), std::string::npos);
+    EXPECT_EQ(m[2].text.find("--input"), std::string::npos);
 }
 
 TEST(Augocc_Farm, shell_quote)
@@ -197,26 +213,57 @@ TEST(Augocc_Farm, resume_submits_the_unfinished_only)
     const Plan plan = demoPlan(dir.string(), true);
     EXPECT_EQ(arraySpec({0, 1, 2, 5, 7, 8}), "0-2,5,7-8");
 
-    // Nothing done: the four stages, each waiting for the one before.
+    // Nothing done: the five stages, each waiting for the one before.
     std::vector<Submission> s = planSubmissions(plan, readStatus(plan));
-    ASSERT_EQ(s.size(), 4u);
+    ASSERT_EQ(s.size(), 5u);
     EXPECT_EQ(s[0].stage, STAGE_SFM);
     EXPECT_EQ(s[0].dependsOn, -1);
+    EXPECT_EQ(s[1].stage, STAGE_CLONE);
+    EXPECT_EQ(s[1].arrayTasks, std::vector<int>({0, 1, 2}));
     EXPECT_EQ(s[1].dependsOn, 0);
-    EXPECT_EQ(s[2].arrayTasks, std::vector<int>({0, 1, 2, 3}));
+    EXPECT_EQ(s[1].script, (dir / "farm" / "2-clone.sh").string());
+    EXPECT_EQ(s[2].stage, STAGE_MERGE);
+    EXPECT_TRUE(s[2].arrayTasks.empty());
     EXPECT_EQ(s[2].dependsOn, 1);
+    EXPECT_EQ(s[2].script, (dir / "farm" / "3-merge.sh").string());
+    EXPECT_EQ(s[3].arrayTasks, std::vector<int>({0, 1, 2, 3}));
     EXPECT_EQ(s[3].dependsOn, 2);
-    EXPECT_EQ(s[2].script, (dir / "farm" / "3-chunks.sh").string());
-    EXPECT_EQ(sbatchArgs(s[2], "41"),
+    EXPECT_EQ(s[4].dependsOn, 3);
+    EXPECT_EQ(s[3].script, (dir / "farm" / "4-chunks.sh").string());
+    EXPECT_EQ(sbatchArgs(s[3], "41"),
               std::vector<std::string>({"--parsable", "--array=0-3",
                                         "--dependency=afterok:41", "--kill-on-invalid-dep=yes",
-                                        s[2].script}));
+                                        s[3].script}));
     EXPECT_EQ(sbatchArgs(s[0], ""), std::vector<std::string>({"--parsable", s[0].script}));
+
+    // sfm done, the part of 'l block' written (its task finished, the others failed): the
+    // clone array over objects 0 and 2, the merge, the chunks, the join.
+    std::ofstream(dir / "tracks.yml") << "x";
+    std::ofstream(dir / "reconstruction.yml") << "x";
+    fs::create_directories(dir / "clones.parts");
+    std::ofstream(dir / clonePartFile("l block")) << "x";
+    Status p0 = readStatus(plan);
+    EXPECT_EQ(p0.cloneParts, std::vector<bool>({false, true, false}));
+    EXPECT_FALSE(p0.clone);
+    s = planSubmissions(plan, p0);
+    ASSERT_EQ(s.size(), 4u);
+    EXPECT_EQ(s[0].stage, STAGE_CLONE);
+    EXPECT_EQ(s[0].arrayTasks, std::vector<int>({0, 2}));
+    EXPECT_EQ(s[0].dependsOn, -1);
+    EXPECT_EQ(s[1].stage, STAGE_MERGE);
+    EXPECT_EQ(s[1].dependsOn, 0);
+    // Every part written, the merge failed: the merge alone before the chunks.
+    std::ofstream(dir / clonePartFile("building")) << "x";
+    std::ofstream(dir / clonePartFile("tower")) << "x";
+    s = planSubmissions(plan, readStatus(plan));
+    ASSERT_EQ(s.size(), 3u);
+    EXPECT_EQ(s[0].stage, STAGE_MERGE);
+    EXPECT_EQ(s[0].dependsOn, -1);
+    EXPECT_EQ(s[1].stage, STAGE_CHUNKS);
 
     // sfm, clone and chunks 0 and 2 finished (chunk 3 has its composite but not its mattes:
     // killed between the two renames): chunks 1 and 3, then the join.
-    std::ofstream(dir / "tracks.yml") << "x";
-    std::ofstream(dir / "reconstruction.yml") << "x";
+    fs::remove_all(dir / "clones.parts");  // the merged file alone says the clones are done
     std::ofstream(dir / "clones.yml.gz") << "x";
     for (const char* c : {"0000-0004", "0008-0012"})
     {
@@ -270,11 +317,17 @@ TEST(Augocc_Farm, plan_file_round_trip)
     EXPECT_EQ(back.frameCount, 16);
     EXPECT_EQ(back.fps, 29.97);
     EXPECT_EQ(back.chunks, plan.chunks);
+    EXPECT_EQ(back.objects, plan.objects);
     EXPECT_EQ(ob.account, "vfx");
     EXPECT_EQ(ob.partition, "");
     EXPECT_EQ(ob.setup, o.setup);
     EXPECT_FALSE(ob.photoRefine);
     EXPECT_THROW(readPlan((dir / "nothing").string(), back, ob), UsageError);
+    // A plan without its objects (an older augocc farm): resume cannot run the clone array.
+    Plan old = plan;
+    old.objects.clear();
+    writePlan(old, o);
+    EXPECT_THROW(readPlan(dir.string(), back, ob), UsageError);
     fs::remove_all(dir);
 }
 

@@ -1,5 +1,6 @@
 // augocc clone: builds the clones of the real objects (the paper's Section 6) from a reconstruction
-// and key-frame masks. A thin shell over cv::augocc::CloneBuilder.
+// and key-frame masks. A thin shell over cv::augocc::CloneBuilder: build(), or buildPart()
+// (--object) and mergeParts() (--merge) for per-object jobs on a farm.
 
 #include "cli_common.hpp"
 
@@ -15,6 +16,8 @@ struct CloneOptions
     std::string reconstruction, masks, out, tracks, orientation, ply, input,
         patchRule = "nearest";
     cv::augocc::CloneBuilder::Params params;  // --voxel-pixels, --rays-per-pixel
+    std::vector<std::string> objects;  // --object: a partial clones file of these
+    std::vector<std::string> merge;    // --merge: partial clones files to merge and finish
     bool noOcclusion = false;
     bool noFreeSpace = false;
 };
@@ -51,10 +54,27 @@ void runClone(const CloneOptions& o, const Globals& g)
         p.box.orientation = CloneBuilder::ORIENT_USER;
         p.box.userRotation = parseOrientation(o.orientation);
     }
+    if (!o.objects.empty() && !o.merge.empty())
+        throw UsageError("--object, --merge: give one of them (--object builds a part, --merge "
+                         "merges the parts)");
+    if (!o.objects.empty() && !o.input.empty())
+        throw UsageError("--input: the photo-consistency carving looks at every object, so it "
+                         "runs when the parts are merged: give --input to clone --merge");
+    for (const std::string& part : o.merge)
+        requireFile("--merge", part);
     const Reconstruction rec = readReconstruction(o.reconstruction);
     const ObjectMasks masks = readMasks(o.masks, rec.imageSize);
     if (masks.empty())
         throw UsageError("--masks " + o.masks + ": no object folder with masks");
+    for (size_t i = 0; i < o.objects.size(); i++)
+    {
+        if (!masks.count(o.objects[i]))
+            throw UsageError("--object " + o.objects[i] + ": no such object in the masks " +
+                             o.masks);
+        for (size_t j = 0; j < i; j++)
+            if (o.objects[j] == o.objects[i])
+                throw UsageError("--object " + o.objects[i] + ": given twice");
+    }
     Tracks tracks;
     if (!o.tracks.empty())
         tracks = readTracks(o.tracks);
@@ -93,7 +113,23 @@ void runClone(const CloneOptions& o, const Globals& g)
         }
         src->checkUnchanged();  // frames of two versions would carve a wrong clone
     }
-    cv::Ptr<CloneSet> clones = builder->build(rec, masks, o.tracks.empty() ? nullptr : &tracks);
+    const Tracks* tr = o.tracks.empty() ? nullptr : &tracks;
+    cv::Ptr<CloneSet> clones;
+    if (!o.objects.empty())
+    {
+        // Passes 1-4 of these objects: a partial clones file for clone --merge.
+        clones = builder->buildPart(rec, masks, std::vector<cv::String>(o.objects.begin(),
+                                                                        o.objects.end()), tr);
+    }
+    else if (!o.merge.empty())
+    {
+        std::vector<cv::Ptr<CloneSet> > parts;
+        for (const std::string& part : o.merge)
+            parts.push_back(CloneSet::loadPart(part));
+        clones = builder->mergeParts(parts, rec, masks, tr);
+    }
+    else
+        clones = builder->build(rec, masks, tr);
     if (!frames.empty())
         builder->refine(*clones, rec, frames);
     progress.finish();
@@ -107,7 +143,8 @@ void runClone(const CloneOptions& o, const Globals& g)
                            clones->voxelCount(name), d[0], d[1], d[2],
                            (int)clones->keyFrames(name).size()));
     }
-    info(g, "clones written to " + o.out);
+    info(g, std::string(o.objects.empty() ? "clones" : "partial clones (merge them with clone "
+                        "--merge)") + " written to " + o.out);
 }
 
 } // namespace
@@ -138,6 +175,12 @@ void registerClone(CLI::App& app, Globals& g)
                   "(the paper's rule)");
     sub->add_flag("--no-free-space", o->noFreeSpace, "with --tracks, do not carve the free space "
                   "the tracks show (silhouettes only, the paper's rule)");
+    sub->add_option("--object", o->objects, "build only this object (repeatable): writes a "
+                    "partial clones file of the passes that need no other object's clone, for "
+                    "clone --merge (doc/farm.md)");
+    sub->add_option("--merge", o->merge, "partial clones files written by clone --object "
+                    "(together every object of --masks, each once): merges them and runs the "
+                    "passes that look at every object; the other flags as for the parts");
     sub->callback([o, &g]() { runClone(*o, g); });
 }
 

@@ -1,5 +1,6 @@
 // augocc farm: writes a shot's (or a shots file's) Slurm workflow and submits it with sbatch:
-// track+sfm -> clone -> a job array over frame chunks -> join, chained with afterok;
+// track+sfm -> a clone job array over objects -> merge -> a job array over frame chunks -> join,
+// chained with afterok;
 // `augocc farm resume` submits what is not finished (doc/farm.md). The scripts and the plan
 // come from farm_workflow.cpp; this file reads the inputs, writes the files and runs sbatch.
 
@@ -82,6 +83,9 @@ Plan planShot(const Shot& s, const Options& w)
     }
     Plan p;
     p.shot = s;
+    // Read here, at submission: the clone array needs its size (doc/farm.md).
+    for (const auto& obj : masks)
+        p.objects.push_back(obj.first);
     p.frameCount = src->count();
     p.fps = src->fps();
     p.chunks = splitFrames(p.frameCount, w.chunkFrames, w.chunks);
@@ -118,8 +122,8 @@ std::string siblingTool(const std::string& sbatch, const std::string& tool)
 void checkNothingQueued(const Plan& plan, const std::string& sbatch)
 {
     std::string names;
-    for (const char* st : {"sfm", "clone", "chunks", "join"})
-        names += (names.empty() ? "" : ",") + ("augocc-" + plan.shot.name + "-") + st;
+    for (Stage st : {STAGE_SFM, STAGE_CLONE, STAGE_MERGE, STAGE_CHUNKS, STAGE_JOIN})
+        names += (names.empty() ? "" : ",") + ("augocc-" + plan.shot.name + "-") + stageName(st);
     const std::string q = runCapture({siblingTool(sbatch, "squeue"), "--noheader",
                                       "--format=%i", "--name=" + names});
     if (q.find_first_not_of(" \n") != std::string::npos)
@@ -184,7 +188,8 @@ void submit(const Globals& g, const Plan& plan, const std::string& sbatch, bool 
         summary += cv::format("%s%s job %s", summary.empty() ? "" : ", ",
                               fs::path(s.script).stem().string().c_str(), id.c_str());
         if (!s.arrayTasks.empty())
-            summary += " (chunks " + arraySpec(s.arrayTasks) + ")";
+            summary += std::string(s.stage == STAGE_CLONE ? " (objects " : " (chunks ") +
+                       arraySpec(s.arrayTasks) + ")";
     }
     info(g, "shot " + plan.shot.outDir + ": submitted " + summary);
 }
@@ -241,8 +246,8 @@ void registerFarm(CLI::App& app, Globals& g)
 {
     auto o = std::make_shared<FarmCliOptions>();
     CLI::App* sub = app.add_subcommand("farm", "write and submit (sbatch) the Slurm workflow of "
-                                       "one shot or a shots file: track+sfm, clone, frame "
-                                       "chunks, join (doc/farm.md)");
+                                       "one shot or a shots file: track+sfm, clone per "
+                                       "object, merge, frame chunks, join (doc/farm.md)");
     sub->add_option("--shots", o->shots, "shots file: a line 'input masks scene out-dir' per "
                     "shot ('-' for no scene, paths relative to the file)");
     sub->add_option("--input", o->input, "one shot: video, image folder or printf pattern");

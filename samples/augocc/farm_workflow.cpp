@@ -37,19 +37,14 @@ std::string absoluteFrom(const fs::path& base, const std::string& p)
     return q.lexically_normal().string();
 }
 
-const char* stageName(Stage s)
-{
-    static const char* names[] = {"sfm", "clone", "chunks", "join"};
-    return names[s];
-}
-
 // The shot's paths a stage's commands use (each variable set only where used: shellcheck).
 enum Uses { USES_INPUT = 1, USES_MASKS = 2, USES_SCENE = 4 };
 
 // #SBATCH header, strict mode, the user's environment lines, and the shot's variables.
 std::string header(const Plan& plan, const Options& o, Stage stage, const std::string& what,
-                   bool array, int uses)
+                   int arrayTasks, int uses)
 {
+    const bool array = arrayTasks > 0;
     const Shot& s = plan.shot;
     std::ostringstream t;
     t << "#!/bin/bash\n"
@@ -66,7 +61,7 @@ std::string header(const Plan& plan, const Options& o, Stage stage, const std::s
     if (!o.timeLimit.empty())
         t << "#SBATCH --time=" << o.timeLimit << "\n";
     if (array)
-        t << "#SBATCH --array=0-" << plan.chunks.size() - 1 << "\n";
+        t << "#SBATCH --array=0-" << arrayTasks - 1 << "\n";
     t << "set -euo pipefail\n";
     if (!o.setup.empty())
     {
@@ -86,6 +81,17 @@ std::string header(const Plan& plan, const Options& o, Stage stage, const std::s
 }
 
 } // namespace
+
+const char* stageName(Stage s)
+{
+    static const char* names[] = {"sfm", "clone", "merge", "chunks", "join"};
+    return names[s];
+}
+
+std::string clonePartFile(const std::string& object)
+{
+    return "clones.parts/" + object + ".yml.gz";
+}
 
 std::string shellQuote(const std::string& s)
 {
@@ -255,7 +261,7 @@ std::vector<Script> makeScripts(const Plan& plan, const Options& o)
     // 1. Tracking and camera recovery: one job (every frame's tracks feed one bundle adjustment).
     std::ostringstream sfm;
     sfm << header(plan, o, STAGE_SFM, "tracking and camera recovery (one job: the whole shot)",
-                  false, USES_INPUT)
+                  0, USES_INPUT)
         << "# Each output is written all or nothing: a file present is finished.\n"
         << "if [ ! -f tracks.yml ]; then\n"
         << "    \"$AUGOCC\" --quiet track --input \"$INPUT\" --out tracks.yml\n"
@@ -265,19 +271,48 @@ std::vector<Script> makeScripts(const Plan& plan, const Options& o)
         << "fi\n";
     scripts.push_back({STAGE_SFM, "1-sfm.sh", sfm.str()});
 
-    // 2. The clones: one job (the passes of all objects see each other, doc/farm.md).
+    // 2. The clones, per object: a job array, task i = object i (passes 1-4 of doc/clones.md
+    // need no other object's clone). The object list is the masks folder's at submission.
+    CV_Assert(!plan.objects.empty());
+    std::ostringstream names;
+    for (size_t i = 0; i < plan.objects.size(); i++)
+        names << (i ? " " : "") << shellQuote(plan.objects[i]);
     std::ostringstream clone;
-    clone << header(plan, o, STAGE_CLONE, "the clones (one job: every object's clone hides the "
-                    "others in its passes)", false,
-                    USES_MASKS | (o.photoRefine ? USES_INPUT : 0))
+    clone << header(plan, o, STAGE_CLONE, "the clones per object (" +
+                    std::to_string(plan.objects.size()) + " objects, a job array, task i = "
+                    "object i)", (int)plan.objects.size(), USES_MASKS)
+          << "# The objects of the masks folder when the shot was submitted (doc/farm.md).\n"
+          << "OBJECTS=(" << names.str() << ")\n"
+          << "i=${SLURM_ARRAY_TASK_ID:?run as a Slurm array task (sbatch), or set "
+             "SLURM_ARRAY_TASK_ID}\n"
+          << "part=\"clones.parts/${OBJECTS[i]}.yml.gz\"\n"
+          << "# The part is written all or nothing: a part present is finished.\n"
+          << "if [ -f \"$part\" ]; then\n"
+          << "    echo \"$part: finished before, not redone\"\n"
+          << "    exit 0\n"
+          << "fi\n"
+          << "mkdir -p clones.parts\n"
+          << "\"$AUGOCC\" --quiet clone --reconstruction reconstruction.yml --masks \"$MASKS\" "
+             "\\\n    --tracks tracks.yml --object \"${OBJECTS[i]}\" --out \"$part\"\n";
+    scripts.push_back({STAGE_CLONE, "2-clone.sh", clone.str()});
+
+    // 3. The merge: the parts into one clones file, and the passes that see every object
+    // (unobserved volume, patch voxels, photo-consistency): one job.
+    std::string parts;
+    for (const std::string& obj : plan.objects)
+        parts += " \\\n        " + shellQuote(clonePartFile(obj));
+    std::ostringstream merge;
+    merge << header(plan, o, STAGE_MERGE, "the clone parts merged (one job: the passes that "
+                    "look at every object)", 0, USES_MASKS | (o.photoRefine ? USES_INPUT : 0))
           << "if [ ! -f clones.yml.gz ]; then\n"
           << "    \"$AUGOCC\" --quiet clone --reconstruction reconstruction.yml --masks \"$MASKS\" "
              "\\\n        --tracks tracks.yml"
-          << (o.photoRefine ? " --input \"$INPUT\"" : "") << " --out clones.yml.gz\n"
+          << (o.photoRefine ? " --input \"$INPUT\"" : "") << " --out clones.yml.gz \\\n"
+          << "        --merge" << parts << "\n"
           << "fi\n";
-    scripts.push_back({STAGE_CLONE, "2-clone.sh", clone.str()});
+    scripts.push_back({STAGE_MERGE, "3-merge.sh", merge.str()});
 
-    // 3. The chunks: a job array, one task per frame range.
+    // 4. The chunks: a job array, one task per frame range.
     std::ostringstream first, end;
     for (size_t i = 0; i < plan.chunks.size(); i++)
     {
@@ -287,7 +322,8 @@ std::vector<Script> makeScripts(const Plan& plan, const Options& o)
     std::ostringstream chunks;
     chunks << header(plan, o, STAGE_CHUNKS, std::string(scene ? "composite" : "mattes") +
                      " of " + std::to_string(plan.chunks.size()) + " frame chunks (a job "
-                     "array, task i = chunk i)", true, scene ? USES_INPUT | USES_SCENE : 0)
+                     "array, task i = chunk i)", (int)plan.chunks.size(),
+                     scene ? USES_INPUT | USES_SCENE : 0)
            << "# Chunk i is frames FIRST[i] .. END[i]-1.\n"
            << "FIRST=(" << first.str() << ")\n"
            << "END=(" << end.str() << ")\n"
@@ -312,12 +348,12 @@ std::vector<Script> makeScripts(const Plan& plan, const Options& o)
         chunks << "\"$AUGOCC\" --quiet matte --reconstruction reconstruction.yml --clones "
                   "clones.yml.gz \\\n    --frames \"${FIRST[i]}:${END[i]}\" --out "
                   "\"$dir/mattes\"\n";
-    scripts.push_back({STAGE_CHUNKS, "3-chunks.sh", chunks.str()});
+    scripts.push_back({STAGE_CHUNKS, "4-chunks.sh", chunks.str()});
 
-    // 4. The join: PNG files copied, the video encoded once from the joined frames.
+    // 5. The join: PNG files copied, the video encoded once from the joined frames.
     std::ostringstream join;
     join << header(plan, o, STAGE_JOIN, "join of the chunks (PNG copied, the video encoded "
-                   "once)", false, 0);
+                   "once)", 0, 0);
     auto list = [&](const char* sub) {
         std::string l;
         for (const auto& c : plan.chunks)
@@ -336,7 +372,7 @@ std::vector<Script> makeScripts(const Plan& plan, const Options& o)
              << "    \"$AUGOCC\" --quiet join --kind frames --fps " << cv::format("%.17g", plan.fps)
              << " --out composite.mp4 composite\n"
              << "fi\n";
-    scripts.push_back({STAGE_JOIN, "4-join.sh", join.str()});
+    scripts.push_back({STAGE_JOIN, "5-join.sh", join.str()});
     return scripts;
 }
 
@@ -348,6 +384,8 @@ Status readStatus(const Plan& plan)
     auto isDir = [&](const fs::path& p) { return fs::is_directory(d / p); };
     Status p;
     p.sfm = isFile("tracks.yml") && isFile("reconstruction.yml");
+    for (const std::string& obj : plan.objects)
+        p.cloneParts.push_back(isFile(clonePartFile(obj)));
     p.clone = isFile("clones.yml.gz");
     for (const auto& c : plan.chunks)
     {
@@ -376,7 +414,15 @@ std::vector<Submission> planSubmissions(const Plan& plan, const Status& p)
     if (!p.sfm)
         add(STAGE_SFM, {});
     if (!p.clone)
-        add(STAGE_CLONE, {});
+    {
+        std::vector<int> objects;
+        for (size_t i = 0; i < plan.objects.size(); i++)
+            if (i >= p.cloneParts.size() || !p.cloneParts[i])
+                objects.push_back((int)i);
+        if (!objects.empty())
+            add(STAGE_CLONE, objects);
+        add(STAGE_MERGE, {});
+    }
     std::vector<int> tasks;
     for (size_t i = 0; i < plan.chunks.size(); i++)
         if (i >= p.chunks.size() || !p.chunks[i])
@@ -460,6 +506,10 @@ std::string planText(const Plan& plan, const Options& o)
     fsw << "chunks" << "[";
     for (const auto& c : plan.chunks)
         fsw << "[:" << c.first << c.second << "]";
+    fsw << "]";
+    fsw << "objects" << "[";
+    for (const std::string& obj : plan.objects)
+        fsw << obj;
     fsw << "]";
     fsw << "partition" << o.partition << "account" << o.account << "time" << o.timeLimit
         << "augocc" << o.augocc << "photo_refine" << (int)o.photoRefine;
@@ -545,6 +595,16 @@ void readPlan(const std::string& outDir, Plan& plan, Options& o)
     }
     if (plan.chunks.empty())
         throw UsageError(path + ": chunks is empty");
+    if (!f["objects"].isSeq() || f["objects"].size() == 0)
+        throw UsageError(path + ": key 'objects' missing or empty (a plan of an augocc farm "
+                         "before the per-object clone jobs: run augocc farm on the shot again)");
+    plan.objects.clear();
+    for (const cv::FileNode& n : f["objects"])
+    {
+        if (!n.isString() || n.string().empty())
+            throw UsageError(path + ": objects: each entry must be an object name");
+        plan.objects.push_back(n.string());
+    }
     o.partition = str("partition");
     o.account = str("account");
     o.timeLimit = str("time");

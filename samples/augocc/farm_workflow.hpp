@@ -35,17 +35,33 @@ struct Options
     bool photoRefine = true;      //!< clone --input (photo-consistency carving), as augocc run
 };
 
-//! A shot with what the submitting machine found out: frame count, frame rate, chunks.
+//! A shot with what the submitting machine found out: frame count, frame rate, chunks, objects.
 struct Plan
 {
     Shot shot;
     int frameCount = 0;
     double fps = 25;
     std::vector<std::pair<int, int> > chunks;  //!< [first, end) frame ranges, in order
+    //! The objects of the masks folder (its subfolders, sorted) when the shot was submitted:
+    //! task i of the clone array builds objects[i].
+    std::vector<std::string> objects;
 };
 
 //! The stages of a shot's workflow, in dependency order.
-enum Stage { STAGE_SFM = 0, STAGE_CLONE = 1, STAGE_CHUNKS = 2, STAGE_JOIN = 3 };
+enum Stage
+{
+    STAGE_SFM = 0,    //!< tracking and camera recovery, one job
+    STAGE_CLONE = 1,  //!< per-object clone parts, a job array over Plan::objects
+    STAGE_MERGE = 2,  //!< the parts merged and finished into clones.yml.gz, one job
+    STAGE_CHUNKS = 3, //!< mattes or composite per frame chunk, a job array
+    STAGE_JOIN = 4    //!< the chunks joined, the video encoded
+};
+
+//! The name of a stage in job names and messages (sfm, clone, merge, chunks, join).
+const char* stageName(Stage stage);
+
+//! The partial clones file of `object`, relative to the out-dir: clones.parts/<object>.yml.gz.
+std::string clonePartFile(const std::string& object);
 
 //! A generated script: file name inside outDir/farm/ and its text.
 struct Script
@@ -75,14 +91,15 @@ std::string chunkDir(const std::pair<int, int>& chunk);
 //! `s` quoted for bash: as is when only safe characters, else in single quotes.
 std::string shellQuote(const std::string& s);
 
-//! The four scripts of a shot (sfm, clone, chunks array, join), in stage order.
+//! The five scripts of a shot (sfm, clone array, merge, chunks array, join), in stage order.
 std::vector<Script> makeScripts(const Plan& plan, const Options& options);
 
 //! What a shot's outputs say is finished (files found in the out-dir).
 struct Status
 {
     bool sfm = false;                //!< tracks.yml and reconstruction.yml
-    bool clone = false;              //!< clones.yml.gz
+    std::vector<bool> cloneParts;    //!< per object of the plan: its clones.parts file
+    bool clone = false;              //!< clones.yml.gz (the parts merged)
     std::vector<bool> chunks;        //!< per chunk: its outputs complete
     bool join = false;               //!< mattes/ (+ composite/ and composite.mp4 with a scene)
 };
@@ -100,8 +117,10 @@ struct Submission
     int dependsOn = -1;
 };
 
-/** @brief The sbatch calls that finish a shot: only the stages not finished, the chunk array
-over the unfinished chunks only; each waits (afterok) for the nearest earlier stage submitted. */
+/** @brief The sbatch calls that finish a shot: only the stages not finished, the clone array
+over the objects without a part only and the chunk array over the unfinished chunks only (no
+clone array nor merge once clones.yml.gz is there); each waits (afterok) for the nearest earlier
+stage submitted. */
 std::vector<Submission> planSubmissions(const Plan& plan, const Status& progress);
 
 //! The sbatch argument list of `s` (after "sbatch"), `dependency` the job id waited for or "".

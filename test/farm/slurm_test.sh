@@ -51,8 +51,16 @@ cluster_start "$T/cluster" || fail "the cluster did not start"
     --chunks 4 --augocc "$AUGOCC" --sbatch "$(command -v sbatch)" --time 00:10:00 |
     tee "$T/submit.txt"
 grep -q "chunks 0-3" "$T/submit.txt" || fail "the 4 chunks were not submitted as one array"
+nobj=$(find "$masks" -mindepth 1 -maxdepth 1 -type d | wc -l)
+grep -q "2-clone job [0-9]* (objects 0-$((nobj - 1)))" "$T/submit.txt" ||
+    fail "the $nobj objects' clones were not submitted as one array"
 cluster_wait 600 || fail "the jobs did not finish"
 [ -f "$T/shot/composite.mp4" ] || fail "no joined composite.mp4"
+# The merged per-object parts are the single-machine clones file, byte for byte.
+"$AUGOCC" --quiet clone --reconstruction "$T/shot/reconstruction.yml" --masks "$masks" \
+    --tracks "$T/shot/tracks.yml" --input "$video" --out "$T/ref_clones.yml.gz"
+cmp -s "$T/ref_clones.yml.gz" "$T/shot/clones.yml.gz" ||
+    fail "the farm's merged clones differ from a single-machine augocc clone"
 
 # Single machine, the same inputs (the shot's own reconstruction and clones).
 "$AUGOCC" --quiet composite --input "$video" --reconstruction "$T/shot/reconstruction.yml" \
@@ -111,7 +119,7 @@ check_same "4 chunks"
 chunk=$T/shot/chunks/0008-0012
 rm -rf "$chunk" "$T/shot/composite" "$T/shot/mattes" "$T/shot/composite.mp4"
 # Its own session, so that the kill reaches augocc and not only the shell running it.
-SLURM_ARRAY_TASK_ID=2 setsid bash "$T/shot/farm/3-chunks.sh" >"$T/killed.log" 2>&1 &
+SLURM_ARRAY_TASK_ID=2 setsid bash "$T/shot/farm/4-chunks.sh" >"$T/killed.log" 2>&1 &
 pid=$!
 killed=0
 for _ in $(seq 3000); do
@@ -129,9 +137,9 @@ wait "$pid" 2>/dev/null || true
 compgen -G "$chunk/.composite.tmp*" >/dev/null || fail "the killed chunk left no temporary"
 
 "$AUGOCC" farm resume --out-dir "$T/shot" --sbatch "$(command -v sbatch)" | tee "$T/resume.txt"
-grep -q "3-chunks job [0-9]* (chunks 2)" "$T/resume.txt" ||
+grep -q "4-chunks job [0-9]* (chunks 2)" "$T/resume.txt" ||
     fail "resume did not submit chunk 2 alone"
-if grep -q "1-sfm\|2-clone" "$T/resume.txt"; then
+if grep -q "1-sfm\|2-clone\|3-merge" "$T/resume.txt"; then
     fail "resume submitted a finished stage again"
 fi
 cluster_wait 600 || fail "the resumed jobs did not finish"

@@ -7,6 +7,7 @@
 #include "precomp.hpp"
 #include "clone/ideal_space.hpp"
 #include "clone/key_frame_coverage.hpp"
+#include "clone/clone_parts.hpp"
 #include "clone/passes.hpp"
 
 namespace cv {
@@ -44,11 +45,12 @@ struct PassProgress
     int64 total;
 };
 
-//! Runs `pass` over every object of `set` in name order and logs what it did to each.
+//! Runs `pass` over the objects `names` of `set` (name order) and logs what it did to each.
 void runPass(const char* name, int64 (*pass)(ObjectClone&, const PassContext&),
-             CloneSetImpl& set, const PassContext& ctx, PassProgress& progress)
+             CloneSetImpl& set, const std::vector<String>& names, const PassContext& ctx,
+             PassProgress& progress)
 {
-    for (const String& object : set.objectNames())
+    for (const String& object : names)
     {
         const int64 n = pass(set.get(object), ctx);
         CV_UNUSED(n);  // with the debug log compiled out
@@ -58,6 +60,49 @@ void runPass(const char* name, int64 (*pass)(ObjectClone&, const PassContext&),
         detail::reportProgress(progress.cb, "clone", "build", ++progress.done, progress.total,
                                "passes", String(name) + ": " + object);
     }
+}
+
+//! build()'s and buildPart()'s input checks; the silhouettes made binary (0 / 255).
+ObjectMasks checkedSilhouettes(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                               const Tracks* tracks, const char* who)
+{
+    if (keyFrameMasks.empty())
+        CV_Error(Error::StsBadArg, cv::format("%s: no object masks", who));
+    if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
+        CV_Error(Error::StsBadSize, cv::format("%s: the reconstruction has no image size", who));
+    if (tracks && !rec.points.empty() && tracks->points() != rec.points.rows)
+        CV_Error(Error::StsBadSize, cv::format("%s: tracks have %d columns, the reconstruction "
+                 "%d points", who, tracks->points(), rec.points.rows));
+    if (!rec.points.empty() && (rec.points.cols != 3 || rec.points.type() != CV_64FC1))
+        CV_Error(Error::StsBadArg, cv::format("%s: reconstruction points must be Nx3 CV_64F",
+                                              who));
+    ObjectMasks bins;
+    for (const auto& o : keyFrameMasks)
+    {
+        if (o.second.empty())
+            CV_Error(Error::StsBadArg, cv::format("%s: object '%s' has no key frame", who,
+                                                  o.first.c_str()));
+        for (const auto& fm : o.second)
+        {
+            checkMask(fm.second, rec, o.first, fm.first);
+            bins[o.first][fm.first] = fm.second > 127;
+        }
+    }
+    return bins;
+}
+
+//! What a part records of its inputs (and what mergeParts() expects of every part).
+PartInfo partInfoOf(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                    const Tracks* tracks, const CloneBuilder::Params& params)
+{
+    PartInfo info;
+    for (const auto& o : keyFrameMasks)
+        info.allObjects.push_back(o.first);
+    info.params = paramsText(params);
+    info.reconstruction = fingerprintReconstruction(rec);
+    info.masks = fingerprintMasks(keyFrameMasks);
+    info.tracks = fingerprintTracks(tracks);
+    return info;
 }
 
 CloneSetImpl& cloneSetOf(CloneSet& clones, const char* who)
@@ -79,6 +124,12 @@ public:
 
     Ptr<CloneSet> build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
                         const Tracks* tracks) const CV_OVERRIDE;
+    Ptr<CloneSet> buildPart(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                            const std::vector<String>& objects,
+                            const Tracks* tracks) const CV_OVERRIDE;
+    Ptr<CloneSet> mergeParts(const std::vector<Ptr<CloneSet> >& parts, const Reconstruction& rec,
+                             const ObjectMasks& keyFrameMasks,
+                             const Tracks* tracks) const CV_OVERRIDE;
     void addKeyFrame(CloneSet& clones, const Reconstruction& rec, const String& object,
                      int frame, InputArray mask) const CV_OVERRIDE;
     int64 refine(CloneSet& clones, const Reconstruction& rec,
@@ -86,6 +137,16 @@ public:
     std::vector<int> photoFrames(const Reconstruction& rec) const CV_OVERRIDE;
 
 private:
+    //! Passes 1-4 (clone/passes.hpp) of `objects` (sorted, of `bins`): a partial set.
+    Ptr<CloneSetImpl> buildObjects(const Reconstruction& rec, const ObjectMasks& bins,
+                                   const std::vector<String>& objects, const Tracks* tracks,
+                                   const PartInfo& info, PassProgress& progress) const;
+    //! Passes 5-6 over every object of a merged set.
+    void finish(CloneSetImpl& set, const Reconstruction& rec, PassProgress& progress) const;
+    //! Units of step "build" per object: in buildObjects(), in finish().
+    int64 partUnits(bool tracks) const;
+    int64 finishUnits() const { return 1 + (params_.unobserved.enabled ? 1 : 0); }
+
     Params params_;
 };
 
@@ -136,35 +197,28 @@ void CloneBuilderImpl::setParams(const Params& p)
     params_ = p;
 }
 
-Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
-                                      const Tracks* tracks) const
+int64 CloneBuilderImpl::partUnits(bool tracks) const
 {
-    if (keyFrameMasks.empty())
-        CV_Error(Error::StsBadArg, "CloneBuilder::build: no object masks");
-    if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
-        CV_Error(Error::StsBadSize, "CloneBuilder::build: the reconstruction has no image size");
-    if (tracks && !rec.points.empty() && tracks->points() != rec.points.rows)
-        CV_Error(Error::StsBadSize, cv::format("CloneBuilder::build: tracks have %d columns, the "
-                 "reconstruction %d points", tracks->points(), rec.points.rows));
-    if (!rec.points.empty() && (rec.points.cols != 3 || rec.points.type() != CV_64FC1))
-        CV_Error(Error::StsBadArg, "CloneBuilder::build: reconstruction points must be Nx3 CV_64F");
-    ObjectMasks bins;
-    for (const auto& o : keyFrameMasks)
-    {
-        if (o.second.empty())
-            CV_Error(Error::StsBadArg, "CloneBuilder::build: object '" + o.first +
-                     "' has no key frame");
-        for (const auto& fm : o.second)
-        {
-            checkMask(fm.second, rec, o.first, fm.first);
-            bins[o.first][fm.first] = fm.second > 127;
-        }
-    }
+    return 3 + (tracks && params_.freeSpace.minViews > 0 ? 1 : 0);
+}
+
+Ptr<CloneSetImpl> CloneBuilderImpl::buildObjects(const Reconstruction& rec,
+                                                 const ObjectMasks& bins,
+                                                 const std::vector<String>& objects,
+                                                 const Tracks* tracks, const PartInfo& info,
+                                                 PassProgress& pp) const
+{
+    // Every object is in the set while the passes run: their silhouettes and centres are what
+    // the passes of `objects` read of them (unknownMask). The others leave before the return.
     Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
     set->patchRule = params_.patches.rule;
     for (const auto& o : bins)
         for (const auto& m : o.second)
             set->add(o.first).masks[m.first] = m.second.clone();
+    std::vector<String> others;
+    for (const auto& o : bins)
+        if (!std::binary_search(objects.begin(), objects.end(), o.first))
+            others.push_back(o.first);
 
     // With a lens, the passes run in its ideal pinhole view (clone/ideal_space.hpp).
     const IdealSpace space = makeIdealSpace(rec, "CloneBuilder::build");
@@ -178,36 +232,147 @@ Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMas
         if (tracks)
             idealTracks = space.tracks(*tracks);
     }
-    const IdealMasks idealMasks(*set, space);
-    PassContext ctx(space.active() ? space.rec : rec, *set, params_);
-    ctx.keyFrameMasks = space.active() ? &idealBins : &bins;
-    ctx.tracks = tracks && space.active() ? &idealTracks : tracks;
+    {
+        const IdealMasks idealMasks(*set, space);
+        PassContext ctx(space.active() ? space.rec : rec, *set, params_);
+        ctx.keyFrameMasks = space.active() ? &idealBins : &bins;
+        ctx.tracks = tracks && space.active() ? &idealTracks : tracks;
+        ctx.inFrame = space.active() ? &space.inFrame : nullptr;
+        // The objects of other parts: their centres alone, as passBox() sets them in theirs.
+        for (const String& name : others)
+            passCentre(set->get(name), ctx);
+        runPass("box", passBox, *set, objects, ctx, pp);                // 1. Steps 1-3
+        runPass("carve", passCarve, *set, objects, ctx, pp);            // 2. Step 4
+        runPass("grid growth", passGridGrowth, *set, objects, ctx, pp);  // 3. beyond Step 3
+        if (tracks && params_.freeSpace.minViews > 0)
+            runPass("free space", passFreeSpace, *set, objects, ctx, pp);  // 4. the tracks
+    }
+    for (const String& name : others)
+        set->erase(name);
+    // Only what a clones file holds goes on (box and points are the first passes' own), so that
+    // a part merged in memory (build()) and one saved and loaded are the same.
+    for (const String& name : objects)
+    {
+        ObjectClone& o = set->get(name);
+        o.box = Box();
+        o.points.clear();
+        o.patches.clear();
+        o.surface = o.grid.surface();
+    }
+    set->partial = true;
+    set->part = info;
+    return set;
+}
+
+void CloneBuilderImpl::finish(CloneSetImpl& set, const Reconstruction& rec,
+                              PassProgress& pp) const
+{
+    const IdealSpace space = makeIdealSpace(rec, "CloneBuilder::build");
+    const IdealMasks idealMasks(set, space);
+    PassContext ctx(space.active() ? space.rec : rec, set, params_);
     ctx.inFrame = space.active() ? &space.inFrame : nullptr;
-    const bool freeSpace = tracks && params_.freeSpace.minViews > 0;
-    PassProgress pp{params_.progress, 0,
-                    (int64)set->objectNames().size() *
-                        (4 + (freeSpace ? 1 : 0) + (params_.unobserved.enabled ? 1 : 0))};
-    detail::reportProgress(pp.cb, "clone", "build", 0, pp.total, "passes");
-    runPass("box", passBox, *set, ctx, pp);                 // 1. Steps 1-3: points, box, grid
-    runPass("carve", passCarve, *set, ctx, pp);             // 2. Step 4: silhouette carving
-    runPass("grid growth", passGridGrowth, *set, ctx, pp);  // 3. the hull beyond Step 3's box
-    if (freeSpace)
-        runPass("free space", passFreeSpace, *set, ctx, pp);  // 4. what the tracks show empty
+    const std::vector<String> all = set.objectNames();
     if (params_.unobserved.enabled)
     {
-        const ObservedSurfaces observed = observeSurfaces(*set, ctx.rec, params_.unobserved,
+        // Every clone's surface as passes 1-4 left it, drawn once for all objects.
+        const ObservedSurfaces observed = observeSurfaces(set, ctx.rec, params_.unobserved,
                                                           ctx.inFrame);
         ctx.observed = &observed;
-        runPass("unobserved", passUnobserved, *set, ctx, pp);  // 5. what no frame sees
+        runPass("unobserved", passUnobserved, set, all, ctx, pp);  // 5. what no frame sees
         ctx.observed = nullptr;
     }
-    runPass("patches", passPatches, *set, ctx, pp);         // 6. Step 5: patch voxels
+    runPass("patches", passPatches, set, all, ctx, pp);  // 6. Step 5: patch voxels
+}
+
+Ptr<CloneSet> CloneBuilderImpl::build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                                      const Tracks* tracks) const
+{
+    // Exactly buildPart() of every object, then mergeParts() of that one part.
+    const ObjectMasks bins = checkedSilhouettes(rec, keyFrameMasks, tracks,
+                                                "CloneBuilder::build");
+    const PartInfo info = partInfoOf(rec, bins, tracks, params_);
+    const int64 n = (int64)bins.size();
+    PassProgress pp{params_.progress, 0, n * (partUnits(tracks != nullptr) + finishUnits())};
+    detail::reportProgress(pp.cb, "clone", "build", 0, pp.total, "passes");
+    Ptr<CloneSetImpl> part = buildObjects(rec, bins, info.allObjects, tracks, info, pp);
+    Ptr<CloneSetImpl> set = combineParts({part.get()}, info);
+    finish(*set, rec, pp);
+    return set;
+}
+
+Ptr<CloneSet> CloneBuilderImpl::buildPart(const Reconstruction& rec,
+                                          const ObjectMasks& keyFrameMasks,
+                                          const std::vector<String>& objects,
+                                          const Tracks* tracks) const
+{
+    const ObjectMasks bins = checkedSilhouettes(rec, keyFrameMasks, tracks,
+                                                "CloneBuilder::buildPart");
+    if (objects.empty())
+        CV_Error(Error::StsBadArg, "CloneBuilder::buildPart: no object to build");
+    std::vector<String> sorted;
+    for (const String& o : objects)
+    {
+        if (!bins.count(o))
+            CV_Error(Error::StsBadArg, "CloneBuilder::buildPart: object '" + o + "' is not an "
+                     "object of the masks");
+        if (std::find(sorted.begin(), sorted.end(), o) != sorted.end())
+            CV_Error(Error::StsBadArg, "CloneBuilder::buildPart: object '" + o + "' is given "
+                     "twice");
+        sorted.push_back(o);
+    }
+    std::sort(sorted.begin(), sorted.end());
+    const PartInfo info = partInfoOf(rec, bins, tracks, params_);
+    PassProgress pp{params_.progress, 0, (int64)sorted.size() * partUnits(tracks != nullptr)};
+    detail::reportProgress(pp.cb, "clone", "build", 0, pp.total, "passes");
+    return buildObjects(rec, bins, sorted, tracks, info, pp);
+}
+
+Ptr<CloneSet> CloneBuilderImpl::mergeParts(const std::vector<Ptr<CloneSet> >& parts,
+                                           const Reconstruction& rec,
+                                           const ObjectMasks& keyFrameMasks,
+                                           const Tracks* tracks) const
+{
+    if (parts.empty())
+        CV_Error(Error::StsBadArg, "CloneBuilder::mergeParts: no part");
+    if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
+        CV_Error(Error::StsBadSize, "CloneBuilder::mergeParts: the reconstruction has no image "
+                 "size");
+    // The parts hold their objects' silhouettes: the masks given here are only fingerprinted.
+    const PartInfo expected = partInfoOf(rec, keyFrameMasks, tracks, params_);
+    // The parts are copied (the caller keeps them); the copies' objects move into the merge.
+    std::vector<CloneSetImpl> copies;
+    copies.reserve(parts.size());
+    for (size_t i = 0; i < parts.size(); i++)
+    {
+        if (parts[i].empty())
+            CV_Error(Error::StsBadArg, cv::format("CloneBuilder::mergeParts: part %d is null",
+                                                  (int)i + 1));
+        const CloneSetImpl* impl = dynamic_cast<const CloneSetImpl*>(parts[i].get());
+        if (!impl)
+            CV_Error(Error::StsBadArg, cv::format("CloneBuilder::mergeParts: part %d was not "
+                     "made by CloneBuilder::buildPart or CloneSet::loadPart", (int)i + 1));
+        copies.push_back(*impl);
+    }
+    std::vector<CloneSetImpl*> ptrs;
+    for (CloneSetImpl& c : copies)
+        ptrs.push_back(&c);
+    Ptr<CloneSetImpl> set = combineParts(ptrs, expected);
+    for (const auto& o : set->objects())
+        for (const auto& m : o.second.masks)
+            if (m.second.size() != rec.imageSize || rec.findCamera(m.first) < 0)
+                CV_Error(Error::StsBadArg, cv::format("CloneBuilder::mergeParts: object '%s': "
+                         "key frame %d does not fit the reconstruction", o.first.c_str(),
+                         m.first));
+    PassProgress pp{params_.progress, 0, (int64)set->objects().size() * finishUnits()};
+    detail::reportProgress(pp.cb, "clone", "build", 0, pp.total, "passes");
+    finish(*set, rec, pp);
     return set;
 }
 
 void CloneBuilderImpl::addKeyFrame(CloneSet& clones, const Reconstruction& rec,
                                    const String& object, int frame, InputArray mask) const
 {
+    checkComplete(clones, "CloneBuilder::addKeyFrame");
     CloneSetImpl& set = cloneSetOf(clones, "addKeyFrame");
     ObjectClone& obj = set.get(object);
     Mat m = mask.getMat();
@@ -239,6 +404,7 @@ std::vector<int> CloneBuilderImpl::photoFrames(const Reconstruction& rec) const
 int64 CloneBuilderImpl::refine(CloneSet& clones, const Reconstruction& rec,
                                InputArrayOfArrays framesArr) const
 {
+    checkComplete(clones, "CloneBuilder::refine");
     CloneSetImpl& set = cloneSetOf(clones, "CloneBuilder::refine");
     if (rec.cameras.empty())
         CV_Error(Error::StsBadArg, "CloneBuilder::refine: the reconstruction has no camera");

@@ -18,6 +18,11 @@ namespace augocc {
 
 CloneSet::~CloneSet() {}
 
+bool CloneSet::isPartial() const
+{
+    return false;
+}
+
 namespace detail {
 
 namespace fsys = std::filesystem;
@@ -39,6 +44,26 @@ ObjectClone& CloneSetImpl::get(const String& object)
     if (it == objects_.end())
         CV_Error(Error::StsObjectNotFound, "clones: no object '" + object + "'");
     return it->second;
+}
+
+void CloneSetImpl::insert(ObjectClone&& clone)
+{
+    CV_Assert(!clone.name.empty() && !objects_.count(clone.name));
+    const String name = clone.name;
+    objects_.emplace(name, std::move(clone));
+}
+
+void checkComplete(const CloneSet& clones, const char* who)
+{
+    if (clones.isPartial())
+    {
+        String names;
+        for (const String& n : clones.objectNames())
+            names += (names.empty() ? "'" : ", '") + n + "'";
+        CV_Error(Error::StsBadArg, cv::format("%s: a partial clone set (objects %s, made by "
+                 "CloneBuilder::buildPart): merge the parts first (CloneBuilder::mergeParts, "
+                 "augocc clone --merge)", who, names.c_str()));
+    }
 }
 
 ObjectClone& CloneSetImpl::add(const String& object)
@@ -175,10 +200,23 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
 void CloneSetImpl::save(const String& path) const
 {
     detail::writeStorageAtomically(path, [&](FileStorage& fs) {
-        fs << "format" << "augocc_clones";
+        // A partial set has a format of its own: readers of complete clones files (this one's
+        // load() and older augocc's) refuse it instead of rendering unfinished clones.
+        fs << "format" << (partial ? "augocc_clones_part" : "augocc_clones");
         fs << "version" << 1;
         fs << "patch_rule" << (patchRule == CloneBuilder::PATCH_BRACKETING ? "bracketing"
                                                                               : "nearest");
+        if (partial)
+        {
+            fs << "part_all_objects" << "[";
+            for (const String& n : part.allObjects)
+                fs << n;
+            fs << "]";
+            fs << "part_params" << part.params;
+            fs << "part_reconstruction" << part.reconstruction;
+            fs << "part_masks" << part.masks;
+            fs << "part_tracks" << part.tracks;
+        }
         fs << "objects" << "[";
         for (const auto& it : objects_)
         {
@@ -246,14 +284,76 @@ void CloneSetImpl::exportPly(const String& dir) const
 
 Ptr<CloneSet> CloneSet::load(const String& path)
 {
-    using namespace detail;
+    return detail::loadCloneSet(path, false);
+}
+
+Ptr<CloneSet> CloneSet::loadPart(const String& path)
+{
+    return detail::loadCloneSet(path, true);
+}
+
+namespace detail {
+
+namespace {
+
+// The partial file's keys (CloneSetImpl::save) into set->part.
+void readPartInfo(const FileStorage& fs, const String& path, CloneSetImpl& set)
+{
+    auto text = [&](const char* key) {
+        const FileNode n = fs[key];
+        if (!n.isString() || n.string().empty())
+            CV_Error(Error::StsParseError, path + cv::format(": key '%s' (of a partial clones "
+                     "file) is missing or not a string", key));
+        return n.string();
+    };
+    const FileNode all = fs["part_all_objects"];
+    if (!all.isSeq() || all.size() == 0)
+        CV_Error(Error::StsParseError, path + ": key 'part_all_objects' (of a partial clones "
+                 "file) must be a non-empty sequence of object names");
+    for (const FileNode& n : all)
+    {
+        if (!n.isString() || n.string().empty())
+            CV_Error(Error::StsParseError, path + ": key 'part_all_objects' holds a value that is "
+                     "not an object name");
+        set.part.allObjects.push_back(n.string());
+    }
+    set.part.params = text("part_params");
+    set.part.reconstruction = text("part_reconstruction");
+    set.part.masks = text("part_masks");
+    set.part.tracks = text("part_tracks");
+    set.part.source = path;
+    set.partial = true;
+}
+
+} // namespace
+
+Ptr<CloneSetImpl> loadCloneSet(const String& path, bool part)
+{
     FileStorage fs = openFileStorageForRead(path, "clones file");
-    if (!fs["format"].isString() || (String)fs["format"] != "augocc_clones")
+    const String format = fs["format"].isString() ? (String)fs["format"] : String();
+    if (format == "augocc_clones_part" && !part)
+    {
+        String names;
+        const FileNode objs = fs["objects"];
+        if (objs.isSeq())
+            for (const FileNode& n : objs)
+                if (n.isMap() && n["name"].isString())
+                    names += (names.empty() ? "'" : ", '") + n["name"].string() + "'";
+        CV_Error(Error::StsBadArg, path + ": a partial clones file (objects " + names +
+                 ", written by augocc clone --object): merge the parts into a clones file first "
+                 "(augocc clone --merge)");
+    }
+    if (format == "augocc_clones" && part)
+        CV_Error(Error::StsBadArg, path + ": a complete clones file, not a part written by "
+                 "augocc clone --object (CloneBuilder::buildPart)");
+    if (format != "augocc_clones" && format != "augocc_clones_part")
         CV_Error(Error::StsParseError, path + ": key 'format' is not 'augocc_clones'");
     if (!fs["version"].isInt() || (int)fs["version"] != 1)
         CV_Error(Error::StsParseError, path + ": key 'version' must be 1 (this augocc reads "
                  "version 1 clones files)");
     Ptr<CloneSetImpl> set = makePtr<CloneSetImpl>();
+    if (part)
+        readPartInfo(fs, path, *set);
     const String rule = fs["patch_rule"].isString() ? (String)fs["patch_rule"] : String();
     if (rule != "bracketing" && rule != "nearest")
         CV_Error(Error::StsParseError, path + ": key 'patch_rule' must be 'bracketing' or "
@@ -364,12 +464,17 @@ Ptr<CloneSet> CloneSet::load(const String& path)
         o.surface = o.grid.surface();
         set->add(o.name) = std::move(o);
     }
+    if (part && set->objects().empty())
+        CV_Error(Error::StsParseError, path + ": a partial clones file with no object");
     return set;
 }
+
+} // namespace detail
 
 void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks& mattes,
                   std::map<String, std::map<int, Mat> >* depth, const ProgressCallback& progress)
 {
+    detail::checkComplete(clones, "renderMattes");
     const std::vector<String> names = clones.objectNames();
     const int nc = (int)rec.cameras.size();
     if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)

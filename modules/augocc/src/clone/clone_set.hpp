@@ -51,11 +51,27 @@ struct ObjectClone
     std::vector<int> points;  //!< Step 1: track columns of the object's reconstructed points
 };
 
+/** @brief What a partial set (CloneBuilder::buildPart()) records for mergeParts() to check:
+every object of the shot and fingerprints of the inputs it was built from (clone/clone_parts.cpp).
+*/
+struct PartInfo
+{
+    std::vector<String> allObjects;  //!< every object of the key-frame masks, sorted
+    String params;                   //!< paramsText() of the builder's parameters
+    String reconstruction;           //!< fingerprintReconstruction()
+    String masks;                    //!< fingerprintMasks()
+    String tracks;                   //!< fingerprintTracks(), "none" without tracks
+    String source;                   //!< the file it was loaded from (for messages), or empty
+};
+
 //! The CloneSet implementation shared by the builder, load() and the tests.
 class CV_EXPORTS CloneSetImpl CV_FINAL : public CloneSet
 {
 public:
     int patchRule = CloneBuilder::PATCH_NEAREST;
+    //! A partial set (buildPart()): `part` says what it was built from.
+    bool partial = false;
+    PartInfo part;
 
     std::vector<String> objectNames() const CV_OVERRIDE;
     void render(const String& object, int frame, const Camera& camera, Size imageSize,
@@ -69,6 +85,12 @@ public:
     double voxelSize(const String& object) const CV_OVERRIDE;
     void gridPose(const String& object, Matx33d& Rbox, Vec3d& origin) const CV_OVERRIDE;
     void exportPly(const String& dir) const CV_OVERRIDE;
+    bool isPartial() const CV_OVERRIDE { return partial; }
+
+    //! Moves `clone` into the set under its name (which must not be there yet).
+    void insert(ObjectClone&& clone);
+    //! Removes the object of that name (nothing when there is none).
+    void erase(const String& object) { objects_.erase(object); }
 
     //! The object named `object`; throws StsObjectNotFound.
     const ObjectClone& get(const String& object) const;
@@ -81,6 +103,13 @@ public:
 private:
     std::map<String, ObjectClone> objects_;
 };
+
+/** @brief Reads a clones file written by CloneSetImpl::save(): a complete one when `part` is
+false, a partial one when true; the other kind is StsBadArg naming the file. */
+CV_EXPORTS Ptr<CloneSetImpl> loadCloneSet(const String& path, bool part);
+
+//! Throws StsBadArg naming `who` when `clones` is a partial set (what needs every object).
+CV_EXPORTS void checkComplete(const CloneSet& clones, const char* who);
 
 } // namespace detail
 } // namespace augocc

@@ -626,7 +626,12 @@ void makeGrid(ObjectClone& obj, const Box& box, const PassContext& ctx)
 }
 
 
-int64 passBox(ObjectClone& obj, const PassContext& ctx)
+namespace {
+
+// Steps 1-2 and Step 1's box (before Step 3 enlarges it): obj.points, and the box. A function of
+// the inputs alone (the reconstruction, the tracks, every object's silhouettes), so a job that
+// builds other objects computes the same box, and the same depth-order centre, as build().
+Box initialBox(ObjectClone& obj, const PassContext& ctx)
 {
     const CloneBuilder::BoxParams& p = ctx.params.box;
     const Reconstruction& rec = ctx.rec;
@@ -645,6 +650,23 @@ int64 passBox(ObjectClone& obj, const PassContext& ctx)
         box = boxFromSilhouettes(rec, obj.masks, R, obj.name);
         box = tightenBySilhouettes(box, rec, obj.masks);
     }
+    return box;
+}
+
+} // namespace
+
+int64 passCentre(ObjectClone& obj, const PassContext& ctx)
+{
+    obj.centre = initialBox(obj, ctx).centre();
+    obj.points.clear();
+    return 0;
+}
+
+int64 passBox(ObjectClone& obj, const PassContext& ctx)
+{
+    const CloneBuilder::BoxParams& p = ctx.params.box;
+    const Reconstruction& rec = ctx.rec;
+    Box box = initialBox(obj, ctx);
     obj.centre = box.centre();
     enlargeBox(box, rec, obj.masks, p.maxEnlargeIterations);
     obj.box = box;

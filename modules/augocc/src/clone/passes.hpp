@@ -17,7 +17,13 @@
 //   5. passUnobserved  vertical runs no frame sees
 //   6. passPatches     Step 5: patch voxels per key frame
 //
-// and CloneBuilder::refine() runs passPhoto, then passPatches. Passes that look at the other
+// Passes 1-4 of object A read, of the other objects, only their key-frame silhouettes and their
+// centres (unknownMask: which object is nearer in a key frame), and a centre is a function of the
+// inputs (passCentre); passes 5 and 6 read the other clones' voxels (observeSurfaces) or follow
+// a pass that does. So CloneBuilder::buildPart() runs 1-4 for some objects (the centres of all)
+// and mergeParts() runs 5-6 over the merged set; build() is the two in a row.
+//
+// CloneBuilder::refine() runs passPhoto, then passPatches. Passes that look at the other
 // clones' voxels (passUnobserved, passPhoto) must see them as they stood before the pass ran on
 // any object: their driver prepares that view once (observeSurfaces(), preparePhotoViews()) and
 // hands it over in the context.
@@ -71,6 +77,9 @@ struct PassContext
 //! Steps 1-3 (the paper's Section 6): obj.points, obj.box, obj.centre and the full grid. obj.masks
 //! must hold the object's binary key-frame silhouettes.
 CV_EXPORTS int64 passBox(ObjectClone& obj, const PassContext& ctx);
+//! obj.centre alone, exactly as passBox() sets it (Step 1's box, before Step 3): what the passes
+//! of the other objects read of obj (unknownMask's depth order) in a job that does not build it.
+CV_EXPORTS int64 passCentre(ObjectClone& obj, const PassContext& ctx);
 
 //! Step 4: carves obj's grid with its key frames (ctx.carveFrame: one of them), then drops the
 //! voxels no key frame shows as the object; updates the surface.

@@ -51,10 +51,26 @@ public:
     virtual void render(const String& object, int frame, const Camera& camera, Size imageSize,
                         OutputArray matte, OutputArray depth = noArray()) const = 0;
 
-    //! Saves to a FileStorage file (`.yml.gz` recommended); atomic.
+    //! Saves to a FileStorage file (`.yml.gz` recommended); atomic. A partial set is written
+    //! as a partial clones file (`format: augocc_clones_part`), which only loadPart() reads.
     virtual void save(const String& path) const = 0;
-    //! Loads a file written by save(); throws naming the file on error.
+    /** @brief Loads a clones file written by save(); throws naming the file on error.
+
+    A partial clones file (a set made by CloneBuilder::buildPart()) is refused with StsBadArg
+    naming the file and its objects: its clones lack the passes that need every object, so
+    rendering it would give wrong mattes. Merge the parts first (CloneBuilder::mergeParts(),
+    `augocc clone --merge`). */
     static Ptr<CloneSet> load(const String& path);
+    /** @brief Loads a partial clones file (a set made by CloneBuilder::buildPart() and saved),
+    for CloneBuilder::mergeParts(). Throws naming the file on error, and StsBadArg when the file
+    is a complete clones file (there is nothing to merge in it: use load()). */
+    static Ptr<CloneSet> loadPart(const String& path);
+    /** @brief True for a partial set: made by CloneBuilder::buildPart() or loadPart(), it holds
+    some objects' clones before the passes that look at every object (unobserved volume, patch
+    voxels). Such a set is input to CloneBuilder::mergeParts() only: rendering its mattes,
+    refine() and addKeyFrame() refuse it. A CloneSet of another implementation is not partial
+    (the default). */
+    virtual bool isPartial() const;
 
     //! Key frames of an object (frames holding a patch set), increasing.
     virtual std::vector<int> keyFrames(const String& object) const = 0;
@@ -225,7 +241,8 @@ public:
         UnobservedParams unobserved;  //!< build(), after the free space
         PhotoParams photo;            //!< refine()
         /** Progress (stage "clone"): build() reports step "build", a unit per pass and
-        object; refine() step "photo-consistency", a unit per object and round. */
+        object (buildPart() and mergeParts() the same step, for the passes each runs); refine()
+        step "photo-consistency", a unit per object and round. */
         ProgressCallback progress;
     };
 
@@ -252,6 +269,55 @@ public:
     */
     virtual Ptr<CloneSet> build(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
                                 const Tracks* tracks = nullptr) const = 0;
+
+    /** @brief The per-object part of build() for some of the objects: a partial clone set, to
+    be saved and merged with the other objects' parts by mergeParts() (issue 21: clone jobs per
+    object on a farm).
+
+    build() runs the passes of doc/clones.md ("How the clone stage works") over every object.
+    Those of one object that read no other object's clone are run here: the box (Steps 1-3),
+    silhouette carving (Step 4), grid growth and the free space (with tracks). They depend on the
+    inputs and, of the other objects, only on what the inputs give: the others' key-frame
+    silhouettes and their depth-order centres (occlusion-aware carving makes a pixel under a
+    nearer object's silhouette unknown; which object is nearer is decided by the centres of
+    Step 1's boxes), which are computed here from the inputs for every object, as build() does.
+    The passes that look at every clone (the unobserved volume, then the patch voxels, which
+    follow it) are left to mergeParts(). build() is exactly buildPart() of every object followed
+    by mergeParts() of that one part, so a merged set equals build()'s, voxel for voxel.
+
+    The set records fingerprints of `rec`, `keyFrameMasks`, `tracks` and the parameters, and
+    every object of `keyFrameMasks`, for mergeParts() to check.
+    @param rec as for build().
+    @param keyFrameMasks every object's silhouettes, as for build() (not only those of
+    `objects`: Step 1 and occlusion-aware carving weigh the other objects' silhouettes).
+    @param objects the objects to build, names of `keyFrameMasks`; not empty, no repeats.
+    @param tracks as for build().
+    @return a partial set (CloneSet::isPartial()) holding the objects of `objects`.
+    Throws as build() does, and StsBadArg naming the object for a name not in `keyFrameMasks`
+    or given twice.
+    */
+    virtual Ptr<CloneSet> buildPart(const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                                    const std::vector<String>& objects,
+                                    const Tracks* tracks = nullptr) const = 0;
+
+    /** @brief Merges partial sets made by buildPart() and runs the passes that look at every
+    object (the unobserved volume, then every object's patch voxels): the set build() makes.
+
+    Checked first, each a StsBadArg naming the part (its file when loaded by
+    CloneSet::loadPart()) and the object: a set that is not partial, an object in two parts, an
+    object of the masks in no part, parts built from other inputs than one another or than the
+    inputs given here (another reconstruction, other masks, other or no tracks, other
+    parameters: the message names the first parameter that differs).
+    @param parts the partial sets, in any order.
+    @param rec the reconstruction the parts were built from.
+    @param keyFrameMasks the masks the parts were built from (only checked against them: the
+    parts hold their objects' silhouettes).
+    @param tracks the tracks the parts were built from, or null if none.
+    @return the complete clone set; refine() may follow, as after build().
+    */
+    virtual Ptr<CloneSet> mergeParts(const std::vector<Ptr<CloneSet> >& parts,
+                                     const Reconstruction& rec, const ObjectMasks& keyFrameMasks,
+                                     const Tracks* tracks = nullptr) const = 0;
 
     /** @brief Adds one key frame to an existing clone: carves with that frame only and recomputes
     the object's patch voxels, without starting over.
