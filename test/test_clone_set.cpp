@@ -64,5 +64,46 @@ TEST(Augocc_CloneBuilder, write_mattes_folder)
     std::filesystem::remove_all(dir);
 }
 
+// writeMattes() streams batches of frames (a bounded number of mattes in memory): over several
+// batches every file equals renderMattes()'s matte and depth of that frame, and no temporary is
+// left beside the two folders.
+TEST(Augocc_CloneBuilder, write_mattes_streams_every_frame)
+{
+    const AnalyticScene s = makeScene(SCALED_ORTHOGRAPHIC, towerAndEll(), 40, 3);
+    Ptr<CloneSet> clones = CloneBuilder::create()->build(s.rec, s.keyMasks);
+    ObjectMasks ref;
+    std::map<String, std::map<int, Mat> > refDepth;
+    renderMattes(*clones, s.rec, ref, &refDepth);
+    const std::string dir = tempDir("clone_mattes_stream");
+    int reports = 0;
+    writeMattes(dir + "/mattes", *clones, s.rec, dir + "/depth",
+                [&](const Progress&) { reports++; });
+    EXPECT_GE(reports, 3);  // 40 frames: more than one batch (at most 4 x threads, at least 8)
+    const ObjectMasks m = readMasks(dir + "/mattes", s.rec.imageSize);
+    ASSERT_EQ(ref.size(), m.size());
+    for (const auto& o : ref)
+    {
+        ASSERT_EQ(o.second.size(), m.at(o.first).size()) << o.first;
+        for (const auto& f : o.second)
+        {
+            EXPECT_EQ(0, countNonZero(f.second != m.at(o.first).at(f.first)))
+                << o.first << " frame " << f.first;
+            const Mat d = imread(cv::format("%s/depth/%s/%04d.tiff", dir.c_str(),
+                                            o.first.c_str(), f.first), IMREAD_UNCHANGED);
+            ASSERT_EQ(CV_32FC1, d.type());
+            EXPECT_EQ(0, countNonZero(d != refDepth.at(o.first).at(f.first)))  // +inf == +inf
+                << o.first << " frame " << f.first;
+        }
+    }
+    int entries = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+    {
+        CV_UNUSED(e);
+        entries++;
+    }
+    EXPECT_EQ(2, entries);  // mattes and depth, no temporary
+    std::filesystem::remove_all(dir);
+}
+
 } // namespace
 } // namespace opencv_test

@@ -471,14 +471,14 @@ Ptr<CloneSetImpl> loadCloneSet(const String& path, bool part)
 
 } // namespace detail
 
-void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks& mattes,
-                  std::map<String, std::map<int, Mat> >* depth, const ProgressCallback& progress)
+namespace {
+
+//! What renderMattes() and writeMattes() check before any work.
+void checkMatteInputs(const CloneSet& clones, const Reconstruction& rec, const char* who)
 {
-    detail::checkComplete(clones, "renderMattes");
-    const std::vector<String> names = clones.objectNames();
-    const int nc = (int)rec.cameras.size();
+    detail::checkComplete(clones, who);
     if (rec.imageSize.width <= 0 || rec.imageSize.height <= 0)
-        CV_Error(Error::StsBadSize, "renderMattes: reconstruction has no image size");
+        CV_Error(Error::StsBadSize, String(who) + ": reconstruction has no image size");
     // A clones file built for other frames: its key-frame silhouettes have another size.
     if (const detail::CloneSetImpl* impl = dynamic_cast<const detail::CloneSetImpl*>(&clones))
         for (const auto& o : impl->objects())
@@ -489,68 +489,121 @@ void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks
                              "clones file of another video?)", o.first.c_str(), km.first,
                              km.second.cols, km.second.rows, rec.imageSize.width,
                              rec.imageSize.height));
-    std::vector<std::vector<Mat> > m(names.size(), std::vector<Mat>(nc)), d = m;
-    // Batches of frames, each in parallel, progress reported between them (from this thread).
-    // Each matte depends on its frame alone: the batching does not change them.
-    const int batch = progress ? std::max(8, 4 * cv::getNumThreads()) : std::max(nc, 1);
-    detail::reportProgress(progress, "matte", "", 0, nc, "frames");
-    for (int b0 = 0; b0 < nc; b0 += batch)
-    {
-        const int b1 = std::min(nc, b0 + batch);
-        parallel_for_(Range(b0, b1), [&](const Range& r) {
-            for (int c = r.start; c < r.end; c++)
-                for (size_t o = 0; o < names.size(); o++)
-                {
-                    if (depth)
-                        clones.render(names[o], rec.cameras[c].frame, rec.cameras[c],
-                                      rec.imageSize, m[o][c], d[o][c]);
-                    else
-                        clones.render(names[o], rec.cameras[c].frame, rec.cameras[c],
-                                      rec.imageSize, m[o][c]);
-                }
-        });
-        detail::reportProgress(progress, "matte", "", b1, nc, "frames");
-    }
+}
+
+/** Renders the mattes (and depth) of cameras [b0, b1) of every object in parallel:
+m[o][c - b0]. Each matte depends on its frame alone, so batching changes nothing. */
+void renderMatteBatch(const CloneSet& clones, const Reconstruction& rec,
+                      const std::vector<String>& names, int b0, int b1, bool withDepth,
+                      std::vector<std::vector<Mat> >& m, std::vector<std::vector<Mat> >& d)
+{
+    m.assign(names.size(), std::vector<Mat>(b1 - b0));
+    d.assign(names.size(), std::vector<Mat>(b1 - b0));
+    parallel_for_(Range(b0, b1), [&](const Range& r) {
+        for (int c = r.start; c < r.end; c++)
+            for (size_t o = 0; o < names.size(); o++)
+            {
+                if (withDepth)
+                    clones.render(names[o], rec.cameras[c].frame, rec.cameras[c], rec.imageSize,
+                                  m[o][c - b0], d[o][c - b0]);
+                else
+                    clones.render(names[o], rec.cameras[c].frame, rec.cameras[c], rec.imageSize,
+                                  m[o][c - b0]);
+            }
+    });
+}
+
+} // namespace
+
+void renderMattes(const CloneSet& clones, const Reconstruction& rec, ObjectMasks& mattes,
+                  std::map<String, std::map<int, Mat> >* depth, const ProgressCallback& progress)
+{
+    checkMatteInputs(clones, rec, "renderMattes");
+    const std::vector<String> names = clones.objectNames();
+    const int nc = (int)rec.cameras.size();
     mattes.clear();
     if (depth)
         depth->clear();
-    for (size_t o = 0; o < names.size(); o++)
-        for (int c = 0; c < nc; c++)
-        {
-            mattes[names[o]][rec.cameras[c].frame] = m[o][c];
-            if (depth)
-                (*depth)[names[o]][rec.cameras[c].frame] = d[o][c];
-        }
+    // Batches of frames, each in parallel, progress reported between them (from this thread).
+    const int batch = progress ? std::max(8, 4 * cv::getNumThreads()) : std::max(nc, 1);
+    detail::reportProgress(progress, "matte", "", 0, nc, "frames");
+    std::vector<std::vector<Mat> > m, d;
+    for (int b0 = 0; b0 < nc; b0 += batch)
+    {
+        const int b1 = std::min(nc, b0 + batch);
+        renderMatteBatch(clones, rec, names, b0, b1, depth != nullptr, m, d);
+        for (size_t o = 0; o < names.size(); o++)
+            for (int c = b0; c < b1; c++)
+            {
+                mattes[names[o]][rec.cameras[c].frame] = m[o][c - b0];
+                if (depth)
+                    (*depth)[names[o]][rec.cameras[c].frame] = d[o][c - b0];
+            }
+        detail::reportProgress(progress, "matte", "", b1, nc, "frames");
+    }
 }
 
 void writeMattes(const String& dir, const CloneSet& clones, const Reconstruction& rec,
                  const String& depthDir, const ProgressCallback& progress)
 {
-    ObjectMasks mattes;
-    std::map<String, std::map<int, Mat> > depth;
-    renderMattes(clones, rec, mattes, depthDir.empty() ? nullptr : &depth, progress);
-    if (!depthDir.empty())
-    {
-        namespace fsys = std::filesystem;
-        fsys::path target(depthDir);
-        if (target.has_parent_path())
-            detail::createDirectories(target.parent_path().string());
-        writeAtomically(depthDir, [&](const String& tmp) {
-            detail::createDirectories(tmp, depthDir);
-            for (const auto& o : depth)
-            {
-                const fsys::path od = fsys::path(tmp) / o.first;
-                detail::createDirectories(od.string(), (target / o.first).string());
-                for (const auto& f : o.second)
+    namespace fsys = std::filesystem;
+    checkMatteInputs(clones, rec, "writeMattes");
+    const std::vector<String> names = clones.objectNames();
+    for (const String& n : names)
+        if (n.empty() || n.find('/') != String::npos)
+            CV_Error(Error::StsBadArg, "invalid object name '" + n + "'");
+    const int nc = (int)rec.cameras.size();
+    const bool withDepth = !depthDir.empty();
+    const fsys::path target(dir), depthTarget(depthDir);
+    if (target.has_parent_path())
+        detail::createDirectories(target.parent_path().string());
+    if (withDepth && depthTarget.has_parent_path())
+        detail::createDirectories(depthTarget.parent_path().string());
+    // Streamed: a batch of frames is rendered in parallel, written, and dropped, so memory does
+    // not grow with the shot (a 300-frame 720p shot held 1 GB of mattes before). Each folder is
+    // written under a temporary name and renamed when complete (the mattes first, then the depth).
+    auto writeAll = [&](const String& tmp, const String& depthTmp) {
+        detail::createDirectories(tmp, dir);
+        for (const String& n : names)
+            detail::createDirectories((fsys::path(tmp) / n).string(), (target / n).string());
+        if (withDepth)
+        {
+            detail::createDirectories(depthTmp, depthDir);
+            for (const String& n : names)
+                detail::createDirectories((fsys::path(depthTmp) / n).string(),
+                                          (depthTarget / n).string());
+        }
+        const int batch = std::max(8, 4 * cv::getNumThreads());
+        detail::reportProgress(progress, "matte", "", 0, nc, "frames");
+        std::vector<std::vector<Mat> > m, d;
+        for (int b0 = 0; b0 < nc; b0 += batch)
+        {
+            const int b1 = std::min(nc, b0 + batch);
+            renderMatteBatch(clones, rec, names, b0, b1, withDepth, m, d);
+            for (size_t o = 0; o < names.size(); o++)
+                for (int c = b0; c < b1; c++)
                 {
-                    const String name = cv::format("%04d.tiff", f.first);
-                    detail::writeImageFile((od / name).string(), f.second,
-                                           (target / o.first / name).string());
+                    const int f = rec.cameras[c].frame;
+                    const String png = cv::format("%04d.png", f);
+                    detail::writeImageFile((fsys::path(tmp) / names[o] / png).string(),
+                                           m[o][c - b0], (target / names[o] / png).string());
+                    if (withDepth)
+                    {
+                        const String tiff = cv::format("%04d.tiff", f);
+                        detail::writeImageFile(
+                            (fsys::path(depthTmp) / names[o] / tiff).string(), d[o][c - b0],
+                            (depthTarget / names[o] / tiff).string());
+                    }
                 }
-            }
+            detail::reportProgress(progress, "matte", "", b1, nc, "frames");
+        }
+    };
+    if (withDepth)
+        writeAtomically(depthDir, [&](const String& depthTmp) {
+            writeAtomically(dir, [&](const String& tmp) { writeAll(tmp, depthTmp); });
         });
-    }
-    writeMasks(dir, mattes);
+    else
+        writeAtomically(dir, [&](const String& tmp) { writeAll(tmp, String()); });
 }
 
 } // namespace augocc
