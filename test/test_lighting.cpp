@@ -328,6 +328,61 @@ TEST(Augocc_CompositorShadow, multithread_reproducibility)
     EXPECT_EQ(cv::norm(out[0], out[1], NORM_INF), 0.0);
 }
 
+// The clones' shadow map is kept between frames that show the same patch sets and rendered
+// again when the set, the clones or the sun change: a compositor run over every frame in turn,
+// back and forth, and after a new key frame, gives what a fresh compositor gives for each frame.
+// (In this scene the patch sets do not reach the composite's shadows: a cache keyed without them
+// passes too; a cache keyed by the clone set's address alone fails after the new key frame.)
+TEST(Augocc_CompositorShadow, regression_cached_clone_map_follows_frames_and_clones)
+{
+    const ShadowScene& s = shadowScene();
+    Compositor::Params cp;
+    cp.sun = s.sun;
+    Ptr<CloneSet> clones = CloneSet::load([&] {
+        const std::string path = tempDir("shadow_cache") + "/clones.yml.gz";
+        s.clones->save(path);
+        return path;
+    }());
+    Ptr<Compositor> running = Compositor::create(cp);
+    running->setVirtualObjects(s.virtualObjects);
+    auto fresh = [&](int f, const CloneSet& c) {
+        Ptr<Compositor> one = Compositor::create(cp);
+        one->setVirtualObjects(s.virtualObjects);
+        Mat out;
+        one->composite(s.scene.frames[f], f, s.scene.groundTruth.camera(f), c, out);
+        return out;
+    };
+    const int order[] = {0, 1, 2, 3, 4, 5, 6, 7, 3, 0, 7};
+    for (int f : order)
+    {
+        Mat out;
+        running->composite(s.scene.frames[f], f, s.scene.groundTruth.camera(f), *clones, out);
+        EXPECT_EQ(0, cv::norm(out, fresh(f, *clones), NORM_INF)) << "frame " << f;
+    }
+    // A new key frame changes the patch sets (and the key frames) of the frames near it.
+    const String object = clones->objectNames()[0];
+    int added = -1;
+    for (int f = 0; f < (int)s.scene.frames.size() && added < 0; f++)
+    {
+        const std::vector<int> k = clones->keyFrames(object);
+        if (std::find(k.begin(), k.end(), f) == k.end())
+            added = f;
+    }
+    ASSERT_GE(added, 0);
+    CloneBuilder::create()->addKeyFrame(*clones, s.scene.groundTruth, object, added,
+                                        s.scene.visibleMasks.at(object).at(added));
+    Mat after;
+    running->composite(s.scene.frames[added], added, s.scene.groundTruth.camera(added), *clones,
+                       after);
+    EXPECT_EQ(0, cv::norm(after, fresh(added, *clones), NORM_INF));
+    // Another sun: the map is rendered again.
+    cp.sun.direction = normalize(s.sun.direction + Vec3d(0.3, 0, 0));
+    running->setParams(cp);
+    Mat turned;
+    running->composite(s.scene.frames[1], 1, s.scene.groundTruth.camera(1), *clones, turned);
+    EXPECT_EQ(0, cv::norm(turned, fresh(1, *clones), NORM_INF));
+}
+
 TEST(Augocc_CompositorShadow, bad_arg)
 {
     Compositor::Params cp;

@@ -478,6 +478,19 @@ private:
             virtualMap_.finish();
             virtualVersion_ = meshVersion_;
         }
+        // The clones' map depends on the frame only through the patch sets it shows (the
+        // nearest key frame's, or the bracketing ones): consecutive frames between two key
+        // frames share it, and it is rendered again only when that set, the clones (their
+        // voxel counts, key frames and grids: what building, refining and adding key frames
+        // change) or the lattice change. Splatting it was 58% of a 1080p composite's time.
+        const String key = cloneMapKey(clones, frameIndex, voxel);
+        const bool sameClones = cloneMapKey_ == key && cloneMap_.size() == lay.size() &&
+                                cloneMap_.cam.pp == lay.cam.pp && cloneMap_.cam.s == lay.cam.s &&
+                                cloneMap_.cam.R == lay.cam.R && cloneMap_.cam.t == lay.cam.t &&
+                                cloneMap_.zNear == lay.zNear && cloneMap_.zFar == lay.zFar;
+        if (sameClones)
+            return;
+        cloneMapKey_.clear();  // until the map is complete (an exception leaves no stale key)
         cloneMap_ = lay;
         cloneMap_.z = lay.z.clone();
         // Voxel splats hold voxel-centre depths: a receiver on a clone sits up to about a
@@ -491,6 +504,30 @@ private:
                 cloneMap_.addDepth(shadowDepth_);
             }
         cloneMap_.finish();
+        cloneMapKey_ = key;
+    }
+
+    //! What the clones' shadow map of a frame depends on besides the lattice (see above).
+    static String cloneMapKey(const CloneSet* clones, int frameIndex, double voxel)
+    {
+        if (!clones)
+            return "none";
+        String k = cv::format("%p %.17g", (const void*)clones, voxel);
+        for (const String& name : clones->objectNames())
+        {
+            const Vec3i n = clones->gridSize(name);
+            Matx33d R;
+            Vec3d o;
+            clones->gridPose(name, R, o);
+            k += cv::format("|%s %d %d %d %d %.17g %.17g %.17g %.17g", name.c_str(),
+                            clones->voxelCount(name), n[0], n[1], n[2], clones->voxelSize(name),
+                            o[0], o[1], o[2]);
+            for (int f : clones->keyFrames(name))
+                k += cv::format(" k%d", f);
+            for (int f : clones->patchFrames(name, frameIndex))
+                k += cv::format(" p%d", f);
+        }
+        return k;
     }
 
     /* The shadow catcher (lighting.hpp): the frame darkened where the virtual objects take the
@@ -1517,6 +1554,7 @@ private:
     // Params::sun: the shadow maps (one lattice), the version of the uploaded meshes the
     // virtual one holds, and the catcher's buffers.
     detail::ShadowMap virtualMap_, cloneMap_;
+    String cloneMapKey_;  // what cloneMap_ was rendered for (cloneMapKey()); empty: nothing
     int meshVersion_ = 0, virtualVersion_ = -1;
     bool insideLens_ = false;
     Mat ambUp_, realZ_, groundMask_, shadowFrame_, shadowFrameBuf_, shadowDepth_;
