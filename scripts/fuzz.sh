@@ -24,7 +24,7 @@ fi
 cmake -S fuzz -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DAUGOCC_BUILD_DIR="$ROOT/build" \
       "${LAUNCHER[@]}" >/dev/null
 cmake --build build-fuzz -j2
-export LSAN_OPTIONS="suppressions=$ROOT/test/sanitizers/lsan.supp"
+export LSAN_OPTIONS="suppressions=$ROOT/test/sanitizers/lsan.supp:print_suppressions=0"  # as scripts/sanitize.sh
 if [ $# -eq 0 ]; then
     ctest --test-dir build-fuzz --output-on-failure -j2 -L 'fuzz|sanitize'
     exit

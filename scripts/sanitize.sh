@@ -14,7 +14,9 @@ if command -v ccache >/dev/null; then
 fi
 # Leaks of system libraries are suppressed by name (test/sanitizers/lsan.supp, with reasons);
 # UBSan stops at the first report so a test fails on it.
-export LSAN_OPTIONS="suppressions=$ROOT/test/sanitizers/lsan.supp"
+# print_suppressions=0: the used-suppressions table goes to stderr at every exit, and tests that
+# check a command's one error line or every line of a log would read it as output.
+export LSAN_OPTIONS="suppressions=$ROOT/test/sanitizers/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAUGOCC_SANITIZE=ON \

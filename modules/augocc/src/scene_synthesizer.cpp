@@ -9,6 +9,7 @@
 // and the ground truth derived from them share one private scene description (sections below).
 
 #include "precomp.hpp"
+#include <cstring>
 #include "gl_context.hpp"
 #include "shading.hpp"
 #include "shadow.hpp"
@@ -1199,9 +1200,14 @@ public:
         if (p.imageSize.width < 32 || p.imageSize.height < 32)
             CV_Error(Error::StsBadArg, cv::format("SceneSynthesizer: imageSize must be at least "
                      "32x32 (got %dx%d)", p.imageSize.width, p.imageSize.height));
-        if (p.model != SCALED_ORTHOGRAPHIC && p.model != PERSPECTIVE)
+        // Read as an int: a CameraModel holding another value is not one to load (UBSan's
+        // enum check, the whole suite under scripts/sanitize.sh).
+        int model = 0;
+        static_assert(sizeof(model) == sizeof(p.model), "CameraModel is an int-sized enum");
+        std::memcpy(&model, &p.model, sizeof(model));
+        if (model != SCALED_ORTHOGRAPHIC && model != PERSPECTIVE)
             CV_Error(Error::StsBadArg, cv::format("SceneSynthesizer: unknown camera model %d",
-                                                  (int)p.model));
+                                                  model));
         if (!(p.distanceRatio >= 1.0) || !std::isfinite(p.distanceRatio))
             CV_Error(Error::StsOutOfRange, cv::format("SceneSynthesizer: distanceRatio must be "
                      ">= 1 (got %g)", p.distanceRatio));
