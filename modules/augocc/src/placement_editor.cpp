@@ -72,6 +72,21 @@ void directionAngles(const GroundFrame& g, const Vec3d& d, const Vec3d& north, d
 
 const double kMinSunElevationDeg = 1, kMaxSunElevationDeg = 89, kMaxSky = 0.95;
 
+//! `base` (its north, sky and penumbra) in the azimuth / elevation form at these angles, the
+//! elevation held in [kMinSunElevationDeg, kMaxSunElevationDeg], the azimuth in [0, 360).
+SceneSun azimuthElevationSun(SceneSun s, double azimuthDeg, double elevationDeg)
+{
+    s.form = SceneSun::SUN_AZIMUTH_ELEVATION;
+    s.azimuthDeg = std::fmod(azimuthDeg, 360.0);
+    if (s.azimuthDeg < 0)
+        s.azimuthDeg += 360;
+    s.elevationDeg = std::max(kMinSunElevationDeg, std::min(kMaxSunElevationDeg, elevationDeg));
+    s.direction = Vec3d(0, 0, 0);
+    s.date.clear();
+    s.time.clear();
+    return s;
+}
+
 Matx44d affine(const Matx33d& A, const Vec3d& t)
 {
     return Matx44d(A(0, 0), A(0, 1), A(0, 2), t[0], A(1, 0), A(1, 1), A(1, 2), t[1],
@@ -555,17 +570,7 @@ public:
         double az, el;
         if (!getSunAngles(az, el))
             return false;
-        SceneSun s = cur_.sun;
-        s.form = SceneSun::SUN_AZIMUTH_ELEVATION;
-        s.azimuthDeg = std::fmod(az + dAzimuthDeg, 360.0);
-        if (s.azimuthDeg < 0)
-            s.azimuthDeg += 360;
-        s.elevationDeg = std::max(kMinSunElevationDeg,
-                                  std::min(kMaxSunElevationDeg, el + dElevationDeg));
-        s.direction = Vec3d(0, 0, 0);
-        s.date.clear();
-        s.time.clear();
-        setSun(s);
+        setSun(azimuthElevationSun(cur_.sun, az + dAzimuthDeg, el + dElevationDeg));
         return true;
     }
 
@@ -587,15 +592,11 @@ public:
     {
         const SunEstimate e = cv::augocc::estimateSun(frames, frameNumbers, rec_, *clones_,
                                                       ground_, params);
-        SceneSun s = cur_.sun.form == SceneSun::SUN_NONE ? SceneSun() : cur_.sun;
-        s.form = SceneSun::SUN_AZIMUTH_ELEVATION;
-        directionAngles(ground_, e.direction, s.north, s.azimuthDeg, s.elevationDeg);
-        s.elevationDeg = std::max(kMinSunElevationDeg, std::min(kMaxSunElevationDeg,
-                                                                s.elevationDeg));
+        const SceneSun base = cur_.sun.form == SceneSun::SUN_NONE ? SceneSun() : cur_.sun;
+        double az = 0, el = 0;
+        directionAngles(ground_, e.direction, base.north, az, el);
+        SceneSun s = azimuthElevationSun(base, az, el);
         s.sky = std::max(0.0, std::min(kMaxSky, e.sky));
-        s.direction = Vec3d(0, 0, 0);
-        s.date.clear();
-        s.time.clear();
         setSun(s);
         estimate_ = e;
         return e;
