@@ -1255,9 +1255,12 @@ public:
                 CV_Error(Error::StsBadArg, cv::format("SceneSynthesizer: distortion must be 4, "
                          "5, 8, 12 or 14 finite coefficients (got %d)", (int)n));
         }
-        if (p.path != PATH_ORBIT && p.path != PATH_HANDHELD)
+        int path = 0;  // read as an int, as the model above
+        static_assert(sizeof(path) == sizeof(p.path), "CameraPath is an int-sized enum");
+        std::memcpy(&path, &p.path, sizeof(path));
+        if (path != PATH_ORBIT && path != PATH_HANDHELD)
             CV_Error(Error::StsBadArg, cv::format("SceneSynthesizer: path must be PATH_ORBIT or "
-                     "PATH_HANDHELD (got %d)", (int)p.path));
+                     "PATH_HANDHELD (got %d)", path));
         if (p.path == PATH_HANDHELD && p.model != PERSPECTIVE)
             CV_Error(Error::StsBadArg, "SceneSynthesizer: path PATH_HANDHELD needs model "
                      "PERSPECTIVE (a hand-held camera near the scene)");
