@@ -11,6 +11,7 @@
 // and the shading it uses are in their own files.
 
 #include "precomp.hpp"
+#include "clone/clone_set.hpp"
 #include "gl_context.hpp"
 #include "pinhole.hpp"
 #include "shading.hpp"
@@ -513,8 +514,19 @@ private:
         if (!clones)
             return "none";
         String k = cv::format("%p %.17g", (const void*)clones, voxel);
+        // augocc's own sets count their changes; another implementation is fingerprinted by
+        // what building, refining and adding key frames change (counting its voxels per frame).
+        const detail::CloneSetImpl* impl = dynamic_cast<const detail::CloneSetImpl*>(clones);
+        if (impl)
+            k += cv::format(" v%llu", (unsigned long long)impl->version());
         for (const String& name : clones->objectNames())
         {
+            if (impl)
+            {
+                for (int f : clones->patchFrames(name, frameIndex))
+                    k += cv::format("|%s p%d", name.c_str(), f);
+                continue;
+            }
             const Vec3i n = clones->gridSize(name);
             Matx33d R;
             Vec3d o;

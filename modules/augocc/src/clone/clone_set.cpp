@@ -4,6 +4,7 @@
 // CloneSet: rendering (matte + depth), file I/O, PLY export and the mattes folder.
 
 #include "precomp.hpp"
+#include <atomic>
 #include "atomic_write.hpp"
 #include "clone/clone_set.hpp"
 #include "clone/clone_codec.hpp"
@@ -30,6 +31,12 @@ namespace fsys = std::filesystem;
 // ---------------------------------------------------------------------------------------------
 // CloneSetImpl
 
+uint64 CloneSetImpl::nextVersion()
+{
+    static std::atomic<uint64> counter(0);
+    return ++counter;
+}
+
 const ObjectClone& CloneSetImpl::get(const String& object) const
 {
     auto it = objects_.find(object);
@@ -40,6 +47,7 @@ const ObjectClone& CloneSetImpl::get(const String& object) const
 
 ObjectClone& CloneSetImpl::get(const String& object)
 {
+    version_ = nextVersion();
     auto it = objects_.find(object);
     if (it == objects_.end())
         CV_Error(Error::StsObjectNotFound, "clones: no object '" + object + "'");
@@ -50,6 +58,7 @@ void CloneSetImpl::insert(ObjectClone&& clone)
 {
     CV_Assert(!clone.name.empty() && !objects_.count(clone.name));
     const String name = clone.name;
+    version_ = nextVersion();
     objects_.emplace(name, std::move(clone));
 }
 
@@ -68,6 +77,7 @@ void checkComplete(const CloneSet& clones, const char* who)
 
 ObjectClone& CloneSetImpl::add(const String& object)
 {
+    version_ = nextVersion();
     ObjectClone& o = objects_[object];
     o.name = object;
     return o;

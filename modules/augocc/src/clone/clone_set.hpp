@@ -90,7 +90,11 @@ public:
     //! Moves `clone` into the set under its name (which must not be there yet).
     void insert(ObjectClone&& clone);
     //! Removes the object of that name (nothing when there is none).
-    void erase(const String& object) { objects_.erase(object); }
+    void erase(const String& object)
+    {
+        version_ = nextVersion();
+        objects_.erase(object);
+    }
 
     //! The object named `object`; throws StsObjectNotFound.
     const ObjectClone& get(const String& object) const;
@@ -99,9 +103,18 @@ public:
     ObjectClone& add(const String& object);
     //! Every object, by name.
     const std::map<String, ObjectClone>& objects() const { return objects_; }
+    /** A process-wide unique stamp of the set's state: new for every set made and at every
+    access that can change an object (the non-const get(), add(), insert(), erase()), so two
+    sets never share one. What caches of a set's renders (the compositor's clone shadow map)
+    compare, instead of the voxels. */
+    uint64 version() const { return version_; }
 
 private:
+    //! The next stamp (thread-safe).
+    static uint64 nextVersion();
+
     std::map<String, ObjectClone> objects_;
+    uint64 version_ = nextVersion();
 };
 
 /** @brief Reads a clones file written by CloneSetImpl::save(): a complete one when `part` is
