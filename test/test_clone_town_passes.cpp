@@ -248,16 +248,18 @@ TEST_P(Augocc_CloneBuilder_Town, pass_diagnostic)
 // 0.985 / 0.983, recall min 0.9970 / 0.9941 (before the box fix 0.979 / 0.975, 0.9879 / 0.9897);
 // the box in front of it 0.983 / 0.981, worst 0.965 / 0.964, recall min 0.9960 / 0.9941. Not met
 // yet, bounded below at the measured figures less about 0.005 so that they cannot fall unseen: the
-// other objects' non-key mean (silo 0.972 / 0.976, house 0.982 / 0.980, hillside 0.980 / 0.958,
-// arch 0.972, border 0.969 / 0.979: the visual hull between key frames 14 degrees apart), worst
-// frame (hillside 0.860 perspective, arch 0.924, border 0.915) and recall (arch 0.962, silo 0.978,
+// other objects' non-key mean (silo 0.972 / 0.976, house 0.982 / 0.980, hillside 0.979 / 0.975,
+// arch 0.972, border 0.969 / 0.980: the visual hull between key frames 14 degrees apart), worst
+// frame (arch 0.924, border 0.915; the hillside 0.943 / 0.951 since Step 1's box without tracks
+// ends at the first wide horizontal gap: 0.958 / 0.860 perspective before, its box stretched 5
+// units deep by ground points hidden behind it) and recall (arch 0.962, silo 0.978,
 // border 0.969: carving keeps a voxel only when its whole footprint is in a silhouette, so a ring
 // of about a pixel goes in the frames between key frames, where only the nearest key frame's
 // patches help).
 const double kTownMeanIoU = 0.98, kTownMinIoU = 0.95, kTownHiddenMeanIoU = 0.97;
 const double kTowerRecall = 0.994;  // target 0.995, met orthographic (0.9970); perspective 0.9941
 const double kFrontRecall = 0.993;  // target 0.995; measured 0.9941 (perspective)
-const double kTownFloorMean = 0.95, kTownFloorMin = 0.855, kTownFloorRecall = 0.955;
+const double kTownFloorMean = 0.964, kTownFloorMin = 0.91, kTownFloorRecall = 0.957;
 
 TEST_P(Augocc_CloneBuilder_Town, accuracy)
 {

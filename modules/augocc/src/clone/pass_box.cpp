@@ -188,12 +188,49 @@ void trimmedRange(std::vector<double>& v, double trim, double& lo, double& hi)
 // volume to the synthesized L-block, hidden behind the building (perspective 0.980 -> 0.965).
 const double kMaxTrimGapFraction = 0.10;
 
-void contiguousRange(std::vector<double>& v, double trim, bool giveLo, bool giveHi, double& lo,
-                     double& hi)
+// Step 1's points are the object's only where they are: without tracks, a point its silhouettes
+// hold in every key frame may also lie behind it, hidden there (the ground behind a building; with
+// tracks, silhouetteVotes counts only the key frames that see a point). Such points stand apart from the object's own, which sample its
+// surface densely; more of them than the trim takes would stretch the box into conjecture behind
+// the object (issue 18: the hillside's box 5 units deep for a true 1.8). So the trimmed range
+// also ends at the first gap, walking outwards from the interquartile core, wider than this
+// fraction of the core's width or this many times the mean spacing of the values in it.
+const double kMaxCoreGapFraction = 0.25;
+const double kMaxCoreGapSpacings = 8.0;
+// A box axis is horizontal (the gap rule applies) within 60 degrees of the horizontal plane.
+const double kMaxHorizontalAxisCos = 0.5;
+
+void coreContiguous(const std::vector<double>& v, int cut, double& lo, double& hi)
+{
+    const int n = (int)v.size();
+    const int q1 = n / 4, q3 = std::max(q1, n - 1 - n / 4);
+    const double core = v[q3] - v[q1];
+    const double gap = std::max(kMaxCoreGapFraction * core,
+                                kMaxCoreGapSpacings * core / std::max(1, q3 - q1));
+    if (!(gap > 0))
+        return;
+    int i = q1;
+    while (i > cut && v[i] - v[i - 1] <= gap)
+        i--;
+    int j = q3;
+    while (j < n - 1 - cut && v[j + 1] - v[j] <= gap)
+        j++;
+    lo = std::max(lo, v[i]);
+    hi = std::min(hi, v[j]);
+}
+
+void contiguousRange(std::vector<double>& v, double trim, bool giveLo, bool giveHi, bool core,
+                     double& lo, double& hi)
 {
     trimmedRange(v, trim, lo, hi);  // sorts v
     const int n = (int)v.size();
     const int cut = std::min((int)std::floor(trim * n), (n - 1) / 2);
+    const double trimmedLo = lo, trimmedHi = hi;
+    if (core)
+        coreContiguous(v, cut, lo, hi);
+    // An end at a gap has nothing beyond it to give back.
+    giveLo = giveLo && lo == trimmedLo;
+    giveHi = giveHi && hi == trimmedHi;
     const double gap = kMaxTrimGapFraction * (hi - lo);
     for (int i = cut - 1; giveLo && i >= 0 && lo - v[i] <= gap; i--)
         lo = v[i];
@@ -216,8 +253,10 @@ bool faceUnseen(const Reconstruction& rec, const FrameMasks& masks, const Vec3d&
     return true;
 }
 
+// Step 1's box. Without tracks (`noTracks`), the horizontal extents also end at the first wide gap
+// from the core (coreContiguous): nothing then says which key frames see a point.
 Box robustBox(const std::vector<Vec3d>& pts, const Matx33d& R, double trim,
-               const Reconstruction& rec, const FrameMasks& masks)
+              const Reconstruction& rec, const FrameMasks& masks, bool noTracks)
 {
     Box b;
     b.R = R;
@@ -231,11 +270,15 @@ Box robustBox(const std::vector<Vec3d>& pts, const Matx33d& R, double trim,
     for (int a = 0; a < 3; a++)
         trimmedRange(c[a], trim, b.lo[a], b.hi[a]);
     const Vec3d centre = R * (0.5 * (b.lo + b.hi));
+    // The points hidden behind an object lie beyond it horizontally; along the vertical an
+    // object's own points may be sparse over a long stretch (a thin stem under a wide cap).
+    const Vec3d up = estimateVertical(rec);
     for (int a = 0; a < 3; a++)
     {
         const Vec3d axis(R(0, a), R(1, a), R(2, a));
+        const bool core = noTracks && std::abs(axis.dot(up)) < kMaxHorizontalAxisCos;
         contiguousRange(c[a], trim, faceUnseen(rec, masks, -axis, centre),
-                        faceUnseen(rec, masks, axis, centre), b.lo[a], b.hi[a]);
+                        faceUnseen(rec, masks, axis, centre), core, b.lo[a], b.hi[a]);
     }
     b.valid = true;
     return b;
@@ -641,7 +684,7 @@ Box initialBox(ObjectClone& obj, const PassContext& ctx)
     const Matx33d R = orientationFor(rec, pts, p);
     Box box;
     if ((int)pts.size() >= p.minPoints)
-        box = robustBox(pts, R, p.trimFraction, rec, obj.masks);
+        box = robustBox(pts, R, p.trimFraction, rec, obj.masks, ctx.tracks == nullptr);
     else
     {
         CV_LOG_INFO(NULL, cv::format("augocc: object '%s': %d reconstructed points in its "
