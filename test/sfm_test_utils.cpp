@@ -195,4 +195,20 @@ bool identicalWithNan(const Mat& a, const Mat& b)
     return true;
 }
 
+LensFigures measureLens(const Reconstruction& est, const Reconstruction& truth)
+{
+    LensFigures m;
+    m.rotationDeg = compareCameras(est, truth, false).meanRotationDeg;
+    const Camera& ce = est.cameras.front();
+    const Camera& ct = truth.camera(ce.frame);
+    if (ce.model == PERSPECTIVE)
+        m.focalErrorPct = 100 * std::abs(ce.K(0, 0) / ct.K(0, 0) - 1);
+    const Size s = truth.imageSize;
+    const Point2d corners[4] = {Point2d(0, 0), Point2d(s.width - 1, 0), Point2d(0, s.height - 1),
+                                Point2d(s.width - 1, s.height - 1)};
+    for (const Point2d& c : corners)
+        m.cornerPx = std::max(m.cornerPx, cv::norm(ce.undistortPixel(c) - ct.undistortPixel(c)));
+    return m;
+}
+
 } // namespace opencv_test

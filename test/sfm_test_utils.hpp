@@ -65,6 +65,20 @@ Z = diag(1, 1, -1)). The global rotation is the chordal L2 mean of R_gt^T R_est.
 CameraComparison compareCameras(const cv::augocc::Reconstruction& est,
                                 const cv::augocc::Reconstruction& gt, bool allowMirror = true);
 
+//! Lens figures of a recovered reconstruction against the truth (issue 15).
+struct LensFigures
+{
+    double rotationDeg = 0;      //!< mean rotation error after the best global rotation
+    double focalErrorPct = 0;    //!< |f_est - f_true| / f_true, percent
+    /** Distortion error at the image corners, pixels: the largest over the four corner pixels
+    p of |undistort_est(p) - undistort_true(p)|, each lens undistorting the frame pixel to the
+    ideal pinhole pixel with its own K (Camera::undistortPixel): how differently the two lenses
+    displace the corners, whatever the focal. */
+    double cornerPx = 0;
+};
+LensFigures measureLens(const cv::augocc::Reconstruction& est,
+                        const cv::augocc::Reconstruction& truth);
+
 //! True when two matrices are bitwise equal, NaN matching NaN (thread-reproducibility tests).
 bool identicalWithNan(const cv::Mat& a, const cv::Mat& b);
 

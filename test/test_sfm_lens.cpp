@@ -119,34 +119,6 @@ HandheldProblem makeHandheld(const HandheldParams& p)
     return out;
 }
 
-// Figures of a recovered reconstruction against the truth.
-struct LensFigures
-{
-    double rotationDeg = 0;      //!< mean rotation error after the best global rotation
-    double focalErrorPct = 0;    //!< |f_est - f_true| / f_true, percent
-    /** Distortion error at the image corners, pixels: the largest over the four corner pixels
-    p of |undistort_est(p) - undistort_true(p)|, each lens undistorting the frame pixel to the
-    ideal pinhole pixel with its own K (Camera::undistortPixel): how differently the two lenses
-    displace the corners, whatever the focal. */
-    double cornerPx = 0;
-};
-
-LensFigures measure(const Reconstruction& est, const Reconstruction& truth)
-{
-    LensFigures m;
-    m.rotationDeg = compareCameras(est, truth, false).meanRotationDeg;
-    const Camera& ce = est.cameras.front();
-    const Camera& ct = truth.camera(ce.frame);
-    if (ce.model == PERSPECTIVE)
-        m.focalErrorPct = 100 * std::abs(ce.K(0, 0) / ct.K(0, 0) - 1);
-    const Size s = truth.imageSize;
-    const Point2d corners[4] = {Point2d(0, 0), Point2d(s.width - 1, 0), Point2d(0, s.height - 1),
-                                Point2d(s.width - 1, s.height - 1)};
-    for (const Point2d& c : corners)
-        m.cornerPx = std::max(m.cornerPx, cv::norm(ce.undistortPixel(c) - ct.undistortPixel(c)));
-    return m;
-}
-
 void printFigures(const char* what, const LensFigures& m, const SfmReport& rep)
 {
     std::cout << cv::format("[ figures  ] %-22s rotation %.4f deg, focal %.3f%%, corners %.3f px, "
@@ -182,7 +154,7 @@ TEST(Augocc_SfmLens, accuracy_calibrated)
     opt.calibration = trueCalibration(p);
     SfmReport rep;
     const Reconstruction rec = recoverCameras(p.tracks, opt, &rep);
-    const LensFigures m = measure(rec, p.truth);
+    const LensFigures m = measureLens(rec, p.truth);
     printFigures("calibrated:", m, rep);
     EXPECT_EQ(rep.lensModel, "given");
     ASSERT_EQ(rec.model, PERSPECTIVE);
@@ -235,8 +207,8 @@ TEST(Augocc_SfmLens, dragged_tracks_left_out)
     SfmOptions all = opt;
     all.explainedRounds = 0;
     SfmReport rep, rep0;
-    const LensFigures m0 = measure(recoverCameras(p.tracks, all, &rep0), p.truth);
-    const LensFigures m = measure(recoverCameras(p.tracks, opt, &rep), p.truth);
+    const LensFigures m0 = measureLens(recoverCameras(p.tracks, all, &rep0), p.truth);
+    const LensFigures m = measureLens(recoverCameras(p.tracks, opt, &rep), p.truth);
     printFigures("dragged, every obs.:", m0, rep0);
     printFigures("dragged, explained:", m, rep);
     std::cout << cv::format("[ figures  ] %d observations moved by > 1 px, %d left out beyond "
@@ -250,7 +222,7 @@ TEST(Augocc_SfmLens, dragged_tracks_left_out)
     EXPECT_GE(rep.unexplainedObservations, moved / 2);
     // Self-calibration on the same tracks: the lens is chosen on the explained observations.
     SfmReport repSelf;
-    const LensFigures ms = measure(recoverCameras(p.tracks, SfmOptions(), &repSelf), p.truth);
+    const LensFigures ms = measureLens(recoverCameras(p.tracks, SfmOptions(), &repSelf), p.truth);
     printFigures("dragged, self-calib.:", ms, repSelf);
     EXPECT_LE(ms.focalErrorPct, kMaxFocalErrorPct);
     EXPECT_LE(ms.cornerPx, kMaxCornerPx);
@@ -266,7 +238,7 @@ TEST(Augocc_SfmLens, accuracy_refine_intrinsics)
     opt.refineIntrinsics = true;
     SfmReport rep;
     const Reconstruction rec = recoverCameras(p.tracks, opt, &rep);
-    const LensFigures m = measure(rec, p.truth);
+    const LensFigures m = measureLens(rec, p.truth);
     printFigures("refined from 2% off:", m, rep);
     EXPECT_EQ(rep.lensModel, "given_refined");
     EXPECT_LE(m.focalErrorPct, kMaxFocalErrorPct);
@@ -286,7 +258,7 @@ TEST(Augocc_SfmLens, accuracy_known_focal)
     opt.focal = hp.focal;
     SfmReport rep;
     const Reconstruction rec = recoverCameras(p.tracks, opt, &rep);
-    const LensFigures m = measure(rec, p.truth);
+    const LensFigures m = measureLens(rec, p.truth);
     printFigures("known focal:", m, rep);
     EXPECT_EQ(rec.cameras.front().K(0, 0), hp.focal);
     EXPECT_TRUE(rec.cameras.front().distortion.empty());
@@ -298,7 +270,7 @@ TEST(Augocc_SfmLens, accuracy_self_calibration)
     const HandheldProblem& p = barrelProblem();
     SfmReport rep;
     const Reconstruction rec = recoverCameras(p.tracks, SfmOptions(), &rep);
-    const LensFigures m = measure(rec, p.truth);
+    const LensFigures m = measureLens(rec, p.truth);
     printFigures("self-calibrated:", m, rep);
     EXPECT_TRUE(rep.lensModel == "focal_k1" || rep.lensModel == "focal_k1_k2") << rep.lensReason;
     EXPECT_LE(m.focalErrorPct, kMaxFocalErrorPct);
@@ -310,7 +282,7 @@ TEST(Augocc_SfmLens, accuracy_self_calibration)
     ignored.selfCalibrate = false;
     SfmReport repIgnored;
     const Reconstruction recIgnored = recoverCameras(p.tracks, ignored, &repIgnored);
-    const LensFigures mi = measure(recIgnored, p.truth);
+    const LensFigures mi = measureLens(recIgnored, p.truth);
     printFigures("distortion ignored:", mi, repIgnored);
     EXPECT_TRUE(recIgnored.cameras.front().distortion.empty());
     EXPECT_GT(mi.cornerPx, 10 * kMaxCornerPx);  // the lens it cannot see: ~tens of px
@@ -326,7 +298,7 @@ TEST(Augocc_SfmLens, no_distortion_keeps_focal_only)
     const HandheldProblem p = makeHandheld(hp);
     SfmReport rep;
     const Reconstruction rec = recoverCameras(p.tracks, SfmOptions(), &rep);
-    printFigures("no distortion:", measure(rec, p.truth), rep);
+    printFigures("no distortion:", measureLens(rec, p.truth), rep);
     EXPECT_EQ(rep.lensModel, "focal") << rep.lensReason;
     EXPECT_TRUE(rec.cameras.front().distortion.empty());
     SfmOptions off;

@@ -190,15 +190,25 @@ const double kMaxTrimGapFraction = 0.10;
 
 // Step 1's points are the object's only where they are: without tracks, a point its silhouettes
 // hold in every key frame may also lie behind it, hidden there (the ground behind a building; with
-// tracks, silhouetteVotes counts only the key frames that see a point). Such points stand apart from the object's own, which sample its
-// surface densely; more of them than the trim takes would stretch the box into conjecture behind
-// the object (issue 18: the hillside's box 5 units deep for a true 1.8). So the trimmed range
-// also ends at the first gap, walking outwards from the interquartile core, wider than this
-// fraction of the core's width or this many times the mean spacing of the values in it.
+// tracks, silhouetteVotes counts only the key frames that see a point). Such points stand apart
+// from the object's own, which sample its surface densely; more of them than the trim takes would
+// stretch the box into conjecture behind the object (issue 18: the hillside's box 5 units deep for
+// a true 1.8). So the trimmed range also ends at the first gap, walking outwards from the
+// interquartile core, wider than this fraction of the core's width or this many times the mean
+// spacing of the values in it.
 const double kMaxCoreGapFraction = 0.25;
 const double kMaxCoreGapSpacings = 8.0;
 // A box axis is horizontal (the gap rule applies) within 60 degrees of the horizontal plane.
 const double kMaxHorizontalAxisCos = 0.5;
+
+// Index reached from i stepping by `step` (+1 or -1) over sorted v while each next value lies
+// within `gap` of the last and the index within [first, last].
+int walkContiguous(const std::vector<double>& v, int i, int step, int first, int last, double gap)
+{
+    while (i + step >= first && i + step <= last && std::abs(v[i + step] - v[i]) <= gap)
+        i += step;
+    return i;
+}
 
 void coreContiguous(const std::vector<double>& v, int cut, double& lo, double& hi)
 {
@@ -209,14 +219,8 @@ void coreContiguous(const std::vector<double>& v, int cut, double& lo, double& h
                                 kMaxCoreGapSpacings * core / std::max(1, q3 - q1));
     if (!(gap > 0))
         return;
-    int i = q1;
-    while (i > cut && v[i] - v[i - 1] <= gap)
-        i--;
-    int j = q3;
-    while (j < n - 1 - cut && v[j + 1] - v[j] <= gap)
-        j++;
-    lo = std::max(lo, v[i]);
-    hi = std::min(hi, v[j]);
+    lo = std::max(lo, v[walkContiguous(v, q1, -1, cut, n - 1 - cut, gap)]);
+    hi = std::min(hi, v[walkContiguous(v, q3, +1, cut, n - 1 - cut, gap)]);
 }
 
 void contiguousRange(std::vector<double>& v, double trim, bool giveLo, bool giveHi, bool core,
@@ -232,10 +236,10 @@ void contiguousRange(std::vector<double>& v, double trim, bool giveLo, bool give
     giveLo = giveLo && lo == trimmedLo;
     giveHi = giveHi && hi == trimmedHi;
     const double gap = kMaxTrimGapFraction * (hi - lo);
-    for (int i = cut - 1; giveLo && i >= 0 && lo - v[i] <= gap; i--)
-        lo = v[i];
-    for (int i = n - cut; giveHi && i < n && v[i] - hi <= gap; i++)
-        hi = v[i];
+    if (giveLo)
+        lo = v[walkContiguous(v, cut, -1, 0, n - 1, gap)];
+    if (giveHi)
+        hi = v[walkContiguous(v, n - 1 - cut, +1, 0, n - 1, gap)];
 }
 
 // True when no key frame sees the face of `box` with outward normal `n` (world): it faces away
@@ -256,7 +260,7 @@ bool faceUnseen(const Reconstruction& rec, const FrameMasks& masks, const Vec3d&
 // Step 1's box. Without tracks (`noTracks`), the horizontal extents also end at the first wide gap
 // from the core (coreContiguous): nothing then says which key frames see a point.
 Box robustBox(const std::vector<Vec3d>& pts, const Matx33d& R, double trim,
-              const Reconstruction& rec, const FrameMasks& masks, bool noTracks)
+              const Reconstruction& rec, const FrameMasks& masks, const Vec3d& up, bool noTracks)
 {
     Box b;
     b.R = R;
@@ -272,7 +276,6 @@ Box robustBox(const std::vector<Vec3d>& pts, const Matx33d& R, double trim,
     const Vec3d centre = R * (0.5 * (b.lo + b.hi));
     // The points hidden behind an object lie beyond it horizontally; along the vertical an
     // object's own points may be sparse over a long stretch (a thin stem under a wide cap).
-    const Vec3d up = estimateVertical(rec);
     for (int a = 0; a < 3; a++)
     {
         const Vec3d axis(R(0, a), R(1, a), R(2, a));
@@ -301,9 +304,8 @@ Matx33d basisFromUp(const Vec3d& up, const Vec3d& hint)
 }
 
 Matx33d autoOrientation(const Reconstruction& rec, const std::vector<Vec3d>& pts, double trim,
-                        int minPoints)
+                        int minPoints, const Vec3d& up)
 {
-    const Vec3d up = estimateVertical(rec);
     Vec3d meanX(0, 0, 0);
     for (const Camera& c : rec.cameras)
         meanX += Vec3d(c.R(0, 0), c.R(0, 1), c.R(0, 2));
@@ -613,13 +615,13 @@ void enlargeBox(Box& box, const Reconstruction& rec, const std::map<int, Mat>& b
 }
 
 Matx33d orientationFor(const Reconstruction& rec, const std::vector<Vec3d>& pts,
-                       const CloneBuilder::BoxParams& p)
+                       const CloneBuilder::BoxParams& p, const Vec3d& up)
 {
     if (p.orientation == CloneBuilder::ORIENT_WORLD)
         return Matx33d::eye();
     if (p.orientation == CloneBuilder::ORIENT_USER)
         return rotationFromRodrigues(p.userRotation);
-    return autoOrientation(rec, pts, p.trimFraction, p.minPoints);
+    return autoOrientation(rec, pts, p.trimFraction, p.minPoints, up);
 }
 
 } // namespace
@@ -681,10 +683,11 @@ Box initialBox(ObjectClone& obj, const PassContext& ctx)
     obj.points.clear();
     std::vector<Vec3d> pts = clusterPoints(rec, *ctx.keyFrameMasks, obj.name, ctx.tracks,
                                            ctx.inFrame, &obj.points);
-    const Matx33d R = orientationFor(rec, pts, p);
+    const Vec3d up = estimateVertical(rec);
+    const Matx33d R = orientationFor(rec, pts, p, up);
     Box box;
     if ((int)pts.size() >= p.minPoints)
-        box = robustBox(pts, R, p.trimFraction, rec, obj.masks, ctx.tracks == nullptr);
+        box = robustBox(pts, R, p.trimFraction, rec, obj.masks, up, ctx.tracks == nullptr);
     else
     {
         CV_LOG_INFO(NULL, cv::format("augocc: object '%s': %d reconstructed points in its "
