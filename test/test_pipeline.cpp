@@ -245,7 +245,10 @@ TEST(Augocc_Pipeline, accuracy_demo)
 // 4-5 px in frames 0-10, where a sliver of the L-block's clone stays in front of the dome's left;
 // under 1 px after frame 38). The issue's 1.5 px is for the default demo; here a regression bound above the measurement.
 // Under the demo's sun (issue 19, 2026-12-03): 99.69%, 3.497 px, 0.110 deg: at the bound.
-const double kPerspectiveDemoMaxBoundaryPx = 3.5;
+// 2026-12-07, points seen under less than 1.5 degrees dropped (2 of 1160 here): 99.72%, 3.529 px,
+// 0.110 deg. The figure moves by a few hundredths of a pixel with any change to the point set
+// (the sliver of frames 0-10); the bound is 2% above the measurement.
+const double kPerspectiveDemoMaxBoundaryPx = 3.6;
 
 TEST(Augocc_Pipeline, accuracy_demo_perspective)
 {

@@ -35,6 +35,10 @@ struct HandheldParams
     double distanceRatio = 1.5;          //!< camera distance / scene size
     double walkMetres = 16;              //!< sideways walk over the sequence
     double noiseSigma = 0.3;             //!< Gaussian pixel noise per axis
+    //! points so far ahead (skyDistance metres) that the walk gives them no measurable
+    //! parallax: a skyline, clouds, a mountain, appended after the `points` ones
+    int skyPoints = 0;
+    double skyDistance = 1e6;
     uint64 seed = 7;
 };
 
@@ -65,9 +69,10 @@ HandheldProblem makeHandheld(const HandheldParams& p)
 {
     RNG rng(p.seed);
     const double h = 0.5 * p.sceneSize;
-    std::vector<Vec3d> X(p.points);
+    const int P = p.points + p.skyPoints;
+    std::vector<Vec3d> X(P);
     const double D = p.distanceRatio * p.sceneSize;
-    for (size_t i = 0; i < X.size(); i++)
+    for (int i = 0; i < p.points; i++)
     {
         if (i % 5 < 2)   // 40% on the street between the camera and the building
             X[i] = Vec3d(rng.uniform(-1.5 * h, 1.5 * h), 0.0,
@@ -76,6 +81,9 @@ HandheldProblem makeHandheld(const HandheldParams& p)
             X[i] = Vec3d(rng.uniform(-h, h), rng.uniform(0.0, 0.6 * p.sceneSize),
                          rng.uniform(-h, h));
     }
+    for (int i = p.points; i < P; i++)   // ahead, within +-0.4 rad, 3 to 11 degrees up
+        X[i] = p.skyDistance * normalize(Vec3d(rng.uniform(-0.4, 0.4), rng.uniform(0.05, 0.2),
+                                               1.0));
     HandheldProblem out;
     out.truth.model = PERSPECTIVE;
     out.truth.imageSize = p.imageSize;
@@ -92,12 +100,12 @@ HandheldProblem makeHandheld(const HandheldParams& p)
         const Matx33d R = lookAt(C, aim, roll);
         out.truth.cameras.push_back(Camera::perspective(R, -(R * C), K, f, p.distortion));
     }
-    out.truth.points = Mat(p.points, 3, CV_64F);
-    for (int i = 0; i < p.points; i++)
+    out.truth.points = Mat(P, 3, CV_64F);
+    for (int i = 0; i < P; i++)
         for (int k = 0; k < 3; k++)
             out.truth.points.at<double>(i, k) = X[i][k];
-    Mat m(p.frames, p.points, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
-    for (int i = 0; i < p.points; i++)
+    Mat m(p.frames, P, CV_32FC2, Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+    for (int i = 0; i < P; i++)
     {
         const int len = rng.uniform(std::max(2, p.frames / 3), p.frames + 1);
         const int start = rng.uniform(0, p.frames - len + 1);
@@ -333,6 +341,62 @@ TEST(Augocc_SfmLens, far_away_keeps_prior)
     if (rec.model == PERSPECTIVE)
     {
         EXPECT_TRUE(rec.cameras.front().distortion.empty());
+    }
+}
+
+/* A skyline ahead: points a million metres away, which the 16 m walk moves by 0.016 px, under
+the 0.3 px noise. Their depth is not in the data: the noise alone decides where the bundle
+adjustment and the triangulation put them, at any distance, behind the cameras, or beyond the
+writer's 1e9 limit (a hand-held shot's own tracks gave a point at 1.17e9, and `augocc sfm` wrote
+no reconstruction). They must come out as not reconstructed (NaN), the building's points as
+before, and the reconstruction must be writable. */
+TEST(Augocc_SfmLens, sky_points_not_reconstructed)
+{
+    HandheldParams hp;
+    hp.skyPoints = 60;
+    const HandheldProblem p = makeHandheld(hp);
+    const String dir = tempDir("sky");
+    for (int calibrated = 1; calibrated >= 0; calibrated--)
+    {
+        SCOPED_TRACE(calibrated ? "calibrated" : "self-calibrated");
+        SfmOptions opt;
+        if (calibrated)
+            opt.calibration = trueCalibration(p);
+        SfmReport rep;
+        const Reconstruction rec = recoverCameras(p.tracks, opt, &rep);
+        const LensFigures m = measureLens(rec, p.truth);
+        printFigures(calibrated ? "sky, calibrated:" : "sky, self-calibrated:", m, rep);
+        int sky = 0, building = 0;
+        for (int i = 0; i < rec.points.rows; i++)
+            (i < hp.points ? building : sky) += rec.hasPoint(i) ? 1 : 0;
+        std::cout << cv::format("[ figures  ] %d of %d sky points, %d of %d others "
+                                "reconstructed (%d reported as too far)", sky, hp.skyPoints,
+                                building, hp.points, rep.unmeasuredDepthTracks) << std::endl;
+        EXPECT_EQ(sky, 0);   // before the fix: all of them, up to 2.9e6 units away
+        // Reported: most sky points (the factorization or the unexplained-observation rounds
+        // may take some first), and no other (every other one kept or rejected otherwise).
+        EXPECT_GT(rep.unmeasuredDepthTracks, hp.skyPoints / 2);
+        EXPECT_LE(rep.unmeasuredDepthTracks, hp.skyPoints);
+        // The others keep their depth (the walk sees them under 10-30 degrees). Measured: 283 of
+        // 300 with the sky, 280 without it (the rest are short tracks the factorization
+        // rejects); 5 fewer than without it would mean the rule takes points it should not.
+        EXPECT_GE(building, 280 - 5);
+        if (calibrated)
+        {
+            EXPECT_LE(m.rotationDeg, kMaxCalibratedRotationDeg);
+        }
+        else
+        {
+            EXPECT_LE(m.focalErrorPct, kMaxFocalErrorPct);
+            EXPECT_TRUE(rep.focalRelStd > 0) << rep.lensReason;   // before: refused, rank-deficient
+            // Not the 0.5 px target: the same shot without the sky gives 0.15 px, with it 0.71
+            // (with or without this rule: the sky's tracks in the earlier stages; open in issue
+            // 15). The bound is the refined-intrinsics one, 1 px.
+            EXPECT_LE(m.cornerPx, 1.0);
+        }
+        const String path = dir + (calibrated ? "/calibrated.yml" : "/self.yml");
+        ASSERT_NO_THROW(writeReconstruction(path, rec));
+        EXPECT_EQ(readReconstruction(path).points.rows, rec.points.rows);
     }
 }
 

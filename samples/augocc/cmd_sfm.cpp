@@ -68,9 +68,11 @@ void registerSfm(CLI::App& app, Globals& g)
         if (!args->ply.empty())
             cv::augocc::writePointsPly(args->ply, rec);
         info(g, cv::format("sfm: %d frames, %d tracks kept (%d of them rejected by the "
-                           "factorization and explained by the final cameras), %d rejected; "
-                           "model %s", (int)rec.cameras.size(), rep.inlierTracks,
-                           rep.rescuedTracks, rep.rejectedTracks, rep.chosenModel.c_str()));
+                           "factorization and explained by the final cameras), %d rejected "
+                           "(%d of them too far for their depth to be measured); model %s",
+                           (int)rec.cameras.size(), rep.inlierTracks, rep.rescuedTracks,
+                           rep.rejectedTracks, rep.unmeasuredDepthTracks,
+                           rep.chosenModel.c_str()));
         info(g, "  factorization:       " + statsLine(rep.factorization));
         info(g, "  3F+1 refinement:     " + statsLine(rep.positionZoom));
         if (opt.bundleAdjust)

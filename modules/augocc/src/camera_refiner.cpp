@@ -584,9 +584,46 @@ double frontOfDominantPlane(const Reconstruction& rec)
 
 namespace {
 
+/* Largest angle between the lines of sight from perspective cameras to X, radians (0 for
+fewer than two): the two-sweep estimate (the direction farthest from the first, then the
+farthest from that one), at least half the true largest angle and exact for centres on a line. */
+double triangulationAngle(const Vec3d& X, const std::vector<const Camera*>& cams)
+{
+    std::vector<Vec3d> dirs;
+    dirs.reserve(cams.size());
+    for (const Camera* c : cams)
+    {
+        const Vec3d d = X - c->center();
+        const double n = cv::norm(d);
+        if (n > 0)
+            dirs.push_back(d / n);
+    }
+    if (dirs.size() < 2)
+        return 0;
+    auto angle = [](const Vec3d& a, const Vec3d& b) {
+        return std::atan2(cv::norm(a.cross(b)), a.dot(b));
+    };
+    size_t far = 0;
+    double best = -1;
+    for (size_t k = 0; k < dirs.size(); k++)
+    {
+        const double a = angle(dirs[0], dirs[k]);
+        if (a > best)
+        {
+            best = a;
+            far = k;
+        }
+    }
+    double largest = 0;
+    for (const Vec3d& d : dirs)
+        largest = std::max(largest, angle(dirs[far], d));
+    return largest;
+}
+
 // Tracks the factorization rejected are triangulated again with the final cameras and kept when
 // these explain them: at least kRescueMinViews frames, reprojection RMS within kRescueRmsPx and
-// every observation within kRescueMaxPx, in front of every perspective camera. The factorization
+// every observation within kRescueMaxPx, in front of every perspective camera and seen under at
+// least detail::kMinTriangulationDeg (see dropUnmeasuredDepths). The factorization
 // judges tracks against the affine model of its first stage; under perspective (hand-held
 // footage near the buildings) some good tracks fit it badly and were dropped, while tracks that
 // slide along an occluding contour fit no camera and stay out. Measured on the perspective demo
@@ -650,7 +687,10 @@ int rescueTracks(const Tracks& tracks, Reconstruction& rec)
                 s2 += e * e;
                 worst = std::max(worst, e);
             }
-            if (front && std::sqrt(s2 / cams.size()) <= kRescueRmsPx && worst <= kRescueMaxPx)
+            const bool measured = cams.front()->model != PERSPECTIVE ||
+                triangulationAngle(Y, cams) >= detail::kMinTriangulationDeg * CV_PI / 180;
+            if (front && measured && std::sqrt(s2 / cams.size()) <= kRescueRmsPx &&
+                worst <= kRescueMaxPx)
             {
                 for (int k = 0; k < 3; k++)
                     X[k] = Y[k];
@@ -1157,10 +1197,66 @@ Reconstruction recoverPinhole(const Tracks& tracks, const SfmOptions& options, S
     return rec;
 }
 
+/* Points whose depth the cameras do not measure: a skyline, clouds, a mountain far behind the
+scene. A point's triangulation angle is the largest angle between its lines of sight from the
+frames that see it; under COLMAP's minimum (1.5 degrees, its mapper's filter_min_tri_angle, applied
+after each bundle adjustment) the point's place along its line of sight is set less by its
+parallax than by the errors: pixel noise, but also what is correlated across frames and does
+not average out, the cameras' own rotation errors and, before the lens is known, the distortion.
+Measured on a synthetic hand-held shot with points 1e6 m ahead (test
+sky_points_not_reconstructed): every such point came out reconstructed, up to 2.9e6 units away;
+a rule of 3 noise sigmas of parallax instead of an angle still kept 10 of 60 after the rescue,
+at 1-2 px of parallax that the cameras' errors gave them. A hand-held shot's own tracks gave one
+at 1.17e9 units, past the writer's limit, and `augocc sfm` wrote no reconstruction. Such points
+are not reconstructed (NaN), here after the first solution and after the last adjustment, and
+the rescue does not bring them back; the cameras keep what they told them about rotation.
+`flagged` (resized to the points) marks every point dropped. */
+int dropUnmeasuredDepths(const Tracks& tracks, Reconstruction& rec, std::vector<uchar>& flagged)
+{
+    if (rec.model != PERSPECTIVE || rec.points.empty())
+        return 0;
+    const double minAngle = detail::kMinTriangulationDeg * CV_PI / 180;
+    std::vector<const Camera*> cameraOf(tracks.frames(), nullptr);
+    for (const Camera& c : rec.cameras)
+        if (c.frame >= 0 && c.frame < tracks.frames())
+            cameraOf[c.frame] = &c;
+    const int P = rec.points.rows;
+    std::vector<uchar> drop(P, 0);
+    parallel_for_(Range(0, P), [&](const Range& r) {
+        std::vector<const Camera*> cams;
+        for (int p = r.start; p < r.end; p++)
+        {
+            if (!rec.hasPoint(p))
+                continue;
+            cams.clear();
+            const Range seen = tracks.track(p);
+            for (int k = seen.start; k < seen.end; k++)
+                if (const Camera* c = cameraOf[tracks.frameOf(k)])
+                    cams.push_back(c);
+            const double* x = rec.points.ptr<double>(p);
+            drop[p] = triangulationAngle(Vec3d(x[0], x[1], x[2]), cams) < minAngle ? 1 : 0;
+        }
+    });
+    flagged.resize(P, 0);
+    int n = 0;
+    for (int p = 0; p < P; p++)
+        if (drop[p])
+        {
+            rec.points.row(p).setTo(std::numeric_limits<double>::quiet_NaN());
+            flagged[p] = 1;
+            n++;
+        }
+    if (n > 0)
+        CV_LOG_INFO(NULL, cv::format("augocc sfm: %d points seen under less than %.1f degrees "
+                    "not reconstructed: the cameras do not measure their depth", n,
+                    detail::kMinTriangulationDeg));
+    return n;
+}
+
 // Self-calibration of the lens after the perspective solution (see SfmOptions::selfCalibrate):
 // focal, focal + k1, focal + k1 + k2 by BIC; the prior kept when the focal is not determined.
 void selfCalibrate(const Tracks& tracks, const SfmOptions& options, Reconstruction& rec,
-                   SfmReport& rep)
+                   SfmReport& rep, std::vector<uchar>& unmeasured)
 {
     rep.lensModel = "focal";
     // Nested models in order: focal + k1, then focal + k1 + k2 only when k1 beat the focal
@@ -1214,8 +1310,14 @@ void selfCalibrate(const Tracks& tracks, const SfmOptions& options, Reconstructi
         return;
     }
     // The focal's standard deviation in the kept model (k2 correlates with the focal).
+    // Points whose depth the cameras do not measure (dropUnmeasuredDepths) stay in the models
+    // above, where as points near infinity they still tell the rotation and the distortion
+    // (taking them out there was tried: no better lens). Their free depths make the covariance
+    // rank-deficient (60 points of a synthetic skyline: refused), so the focal's deviation is
+    // computed without them.
     double relStd = -1;
     Reconstruction best = models[bestModel];
+    dropUnmeasuredDepths(tracks, best, unmeasured);
     adjustLens(tracks, best, bestModel == 1 ? free1 : free2, options.refiner, &relStd, false);
     rep.focalRelStd = relStd;
     // ceres::Covariance's SPARSE_QR refuses a Jacobian it finds rank-deficient; with the scale
@@ -1274,6 +1376,7 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
     SfmReport rep;
     Reconstruction rec;
     Camera lens;
+    std::vector<uchar> unmeasured;   // tracks dropped by dropUnmeasuredDepths, at any stage
     if (knownLens(options, tracks.imageSize, lens))
     {
         // Known intrinsics: the affine and perspective stages on the undistorted observations,
@@ -1285,6 +1388,7 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
         pinhole.model = "perspective";
         rec = recoverPinhole(idealTracks(tracks, lens), pinhole, rep);
         applyKnownLens(rec, lens);
+        dropUnmeasuredDepths(tracks, rec, unmeasured);
         LensFreedom freedom;
         freedom.focal = options.refineIntrinsics;
         if (options.refineIntrinsics)
@@ -1302,6 +1406,7 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
     else
     {
         rec = recoverPinhole(tracks, options, rep);
+        dropUnmeasuredDepths(tracks, rec, unmeasured);
         if (rec.model != PERSPECTIVE)
         {
             rep.lensModel = "none";
@@ -1316,7 +1421,7 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
         else
         {
             const Reconstruction pinhole = rec;
-            selfCalibrate(tracks, options, rec, rep);
+            selfCalibrate(tracks, options, rec, rep, unmeasured);
             // The lens chosen again on the observations that lens explains: the first choice's
             // BIC and covariance carry the bias of the unexplained ones (dropUnexplained).
             // Judged against the chosen lens, not the pinhole, so that the corners' distortion
@@ -1330,7 +1435,7 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
                 for (int p = 0; p < again.points.rows; p++)
                     if (!judged.hasPoint(p))
                         again.points.row(p).setTo(std::numeric_limits<double>::quiet_NaN());
-                selfCalibrate(kept, options, again, rep);
+                selfCalibrate(kept, options, again, rep, unmeasured);
                 rec = again;
             }
         }
@@ -1359,8 +1464,17 @@ Reconstruction recoverCameras(const Tracks& tracks, const SfmOptions& options, S
         rep.distortion = rec.cameras.front().distortion;
     }
     rep.rescuedTracks = rescueTracks(tracks, rec);
-    rep.inlierTracks += rep.rescuedTracks;
-    rep.rejectedTracks -= rep.rescuedTracks;
+    dropUnmeasuredDepths(tracks, rec, unmeasured);
+    // Counted on the output: every stage above may have dropped points.
+    rep.inlierTracks = 0;
+    rep.unmeasuredDepthTracks = 0;
+    for (int p = 0; p < rec.points.rows; p++)
+    {
+        const bool kept = rec.hasPoint(p);
+        rep.inlierTracks += kept ? 1 : 0;
+        rep.unmeasuredDepthTracks += !kept && p < (int)unmeasured.size() && unmeasured[p];
+    }
+    rep.rejectedTracks = rec.points.rows - rep.inlierTracks;
     if (report)
         *report = rep;
     return rec;

@@ -45,8 +45,6 @@ namespace detail {
 
 namespace {
 
-// COLMAP's incremental mapper triangulates with at least 1.5 degrees between lines of sight.
-const double kMinTriangulationDeg = 1.5;
 // A frame is resected from at least this many inlier points (6 unknowns, 2 equations each;
 // margin against near-coplanar sets, as the affine resection of the factorization).
 const int kMinResectInliers = 6;

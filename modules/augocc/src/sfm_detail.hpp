@@ -16,6 +16,11 @@ namespace cv {
 namespace augocc {
 namespace detail {
 
+//! COLMAP's minimum triangulation angle (its mapper's min_tri_angle and filter_min_tri_angle),
+//! degrees: points seen under less are not triangulated (incremental path) nor kept after the
+//! last adjustment (recoverCameras): their depth is set by the errors, not the parallax.
+const double kMinTriangulationDeg = 1.5;
+
 //! One observation of a track in a frame.
 struct SfmObservation
 {

@@ -190,6 +190,9 @@ struct CV_EXPORTS SfmReport
     //! of the tracks the factorization rejected, those the final cameras explain (counted in
     //! inlierTracks)
     int rescuedTracks = 0;
+    //! tracks whose point has a parallax under 3 noise sigmas: the cameras do not measure its
+    //! depth (a skyline, a far mountain), so it is not reconstructed (counted in rejectedTracks)
+    int unmeasuredDepthTracks = 0;
     ReprojectionStats factorization;  //!< after the factorization
     ReprojectionStats positionZoom;   //!< after the paper's 3F+1
     ReprojectionStats orthographic;   //!< after the scaled-orthographic BA (if run)
