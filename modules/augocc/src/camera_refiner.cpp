@@ -584,6 +584,16 @@ double frontOfDominantPlane(const Reconstruction& rec)
 
 namespace {
 
+/* The camera of each frame of `tracks` (nullptr where the reconstruction has none). */
+std::vector<const Camera*> camerasByFrame(const Tracks& tracks, const Reconstruction& rec)
+{
+    std::vector<const Camera*> cameraOf(tracks.frames(), nullptr);
+    for (const Camera& c : rec.cameras)
+        if (c.frame >= 0 && c.frame < tracks.frames())
+            cameraOf[c.frame] = &c;
+    return cameraOf;
+}
+
 /* Largest angle between the lines of sight from perspective cameras to X, radians (0 for
 fewer than two): the two-sweep estimate (the direction farthest from the first, then the
 farthest from that one), at least half the true largest angle and exact for centres on a line. */
@@ -637,10 +647,7 @@ int rescueTracks(const Tracks& tracks, Reconstruction& rec)
 {
     const int P = rec.points.rows;
     std::vector<uchar> ok(P, 0);
-    std::vector<const Camera*> cameraOf(tracks.frames(), nullptr);
-    for (const Camera& c : rec.cameras)
-        if (c.frame < tracks.frames())
-            cameraOf[c.frame] = &c;
+    const std::vector<const Camera*> cameraOf = camerasByFrame(tracks, rec);
     parallel_for_(Range(0, P), [&](const Range& r) {
         for (int p = r.start; p < r.end; p++)
         {
@@ -687,10 +694,10 @@ int rescueTracks(const Tracks& tracks, Reconstruction& rec)
                 s2 += e * e;
                 worst = std::max(worst, e);
             }
-            const bool measured = cams.front()->model != PERSPECTIVE ||
-                triangulationAngle(Y, cams) >= detail::kMinTriangulationDeg * CV_PI / 180;
-            if (front && measured && std::sqrt(s2 / cams.size()) <= kRescueRmsPx &&
-                worst <= kRescueMaxPx)
+            // The angle last: it is the costliest test.
+            if (front && std::sqrt(s2 / cams.size()) <= kRescueRmsPx && worst <= kRescueMaxPx &&
+                (cams.front()->model != PERSPECTIVE ||
+                 triangulationAngle(Y, cams) >= detail::kMinTriangulationDeg * CV_PI / 180))
             {
                 for (int k = 0; k < 3; k++)
                     X[k] = Y[k];
@@ -981,10 +988,7 @@ are. Returns the count of observations dropped; `thresholdPx` gets the threshold
 int dropUnexplained(const Tracks& tracks, Reconstruction& rec, Tracks& kept, double& thresholdPx)
 {
     const int P = tracks.points(), N = tracks.observations();
-    std::vector<const Camera*> cameraOf(tracks.frames(), nullptr);
-    for (const Camera& cam : rec.cameras)
-        if (cam.frame >= 0 && cam.frame < tracks.frames())
-            cameraOf[cam.frame] = &cam;
+    const std::vector<const Camera*> cameraOf = camerasByFrame(tracks, rec);
     // Residual of every observation judged (NaN: not judged), by observation index.
     std::vector<float> e(N, std::numeric_limits<float>::quiet_NaN());
     parallel_for_(Range(0, N), [&](const Range& r) {
@@ -1216,10 +1220,7 @@ int dropUnmeasuredDepths(const Tracks& tracks, Reconstruction& rec, std::vector<
     if (rec.model != PERSPECTIVE || rec.points.empty())
         return 0;
     const double minAngle = detail::kMinTriangulationDeg * CV_PI / 180;
-    std::vector<const Camera*> cameraOf(tracks.frames(), nullptr);
-    for (const Camera& c : rec.cameras)
-        if (c.frame >= 0 && c.frame < tracks.frames())
-            cameraOf[c.frame] = &c;
+    const std::vector<const Camera*> cameraOf = camerasByFrame(tracks, rec);
     const int P = rec.points.rows;
     std::vector<uchar> drop(P, 0);
     parallel_for_(Range(0, P), [&](const Range& r) {
