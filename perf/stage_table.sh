@@ -2,10 +2,11 @@
 # This file is part of augocc. License: Apache-2.0.
 # Issue 16's table: wall time and peak memory of every stage of the pipeline, per resolution and
 # shot length. For each case WxH:N it synthesizes a shot (`augocc synth`: N frames of WxH, the
-# scaled orthographic orbit, 6 key frames; not timed) and runs the stages `augocc run` runs, one
-# process each so that each has its own peak: track (the video), sfm, clone (tracks and
-# photo-consistency over the video), matte, composite (the demo's dome and tree under its sun,
-# to H.264). Prints one Markdown row per case: seconds / peak RSS in MB per stage, and the total.
+# scaled orthographic orbit, 6 key frames; its time and peak on stderr, not in the row) and runs
+# the stages `augocc run` runs, one process each so that each has its own peak: track (the
+# video), sfm, clone (tracks and photo-consistency over the video), matte, composite (the demo's
+# dome and tree under its sun, to H.264). Prints one Markdown row per case: seconds / peak RSS in
+# MB per stage, and the total.
 #
 #   perf/stage_table.sh [BIN] [OUTDIR] [WxH:N ...]
 # default cases: 640x480:60 640x480:300 1280x720:60 1280x720:300 1920x1080:60 1920x1080:300
@@ -67,7 +68,10 @@ for case in $CASES; do
     D="$OUT/${size}_$frames"
     rm -rf "$D"
     mkdir -p "$D"
-    "$BIN" --quiet synth --out "$D/shot" --size "$size" --frames "$frames" > "$D/log_synth.txt" 2>&1
+    /usr/bin/time -f "%e %M" -o "$D/time_synth.txt" \
+        "$BIN" --quiet synth --out "$D/shot" --size "$size" --frames "$frames" > "$D/log_synth.txt" 2>&1
+    read -r secs kb < "$D/time_synth.txt"
+    echo "stage_table: $case synthesized in $secs s, peak $(( kb / 1024 )) MB (not in the row)" >&2
     row="| $size x $frames"
     total=0
     stage track --input "$D/shot/video.mp4" --out "$D/tracks.yml"

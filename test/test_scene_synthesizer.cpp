@@ -5,9 +5,11 @@
 #include "stats.hpp"
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <opencv2/video/tracking.hpp>
+#include <opencv2/videoio.hpp>
 
 namespace opencv_test {
 namespace {
@@ -458,6 +460,77 @@ TEST(Augocc_SceneSynthesizer, regression_deterministic)
     EXPECT_EQ(cv::norm(a.tracks.dense() != b.tracks.dense(), NORM_INF), 0)
         << "same tracks, NaN at the same places";
     EXPECT_GT(cv::norm(a.frames[0], c.frames[0], NORM_L1), 0) << "another seed, other textures";
+}
+
+// SceneSynthesizer::write (`augocc synth`) renders and writes frame by frame; its files must be
+// those of synthesize() + writeSyntheticScene() but for the depth's scale, which it takes from
+// the scene's bounds (an upper bound of the depths: a scale never larger).
+TEST(Augocc_SceneSynthesizer, streamed_write_equals_in_memory)
+{
+    namespace fs = std::filesystem;
+    SceneSynthesizer::Params p = smallParams(PERSPECTIVE);
+    p.frames = 10;  // more than one write batch (8 frames)
+    const std::string root = tempDir("streamed");
+    const std::string memDir = root + "/memory", streamDir = root + "/streamed";
+    SyntheticScene scene;
+    Ptr<SceneSynthesizer> synth = SceneSynthesizer::create(p);
+    synth->synthesize(scene);
+    writeSyntheticScene(memDir, scene, p);
+    synth->write(streamDir);
+
+    std::vector<std::string> files;
+    for (const auto& e : fs::recursive_directory_iterator(memDir))
+        if (e.is_regular_file())
+            files.push_back(fs::relative(e.path(), memDir).string());
+    size_t streamed = 0;
+    for (const auto& e : fs::recursive_directory_iterator(streamDir))
+        streamed += e.is_regular_file() ? 1 : 0;
+    EXPECT_EQ(streamed, files.size()) << "the same files";
+    ASSERT_GT(files.size(), (size_t)(10 * (2 + 2 * 3 + 1)));
+    auto text = [](const std::string& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    };
+    const double scaleMem = (double)FileStorage(memDir + "/gt/depth/depth.yml",
+                                                FileStorage::READ)["scale"];
+    const double scaleStream = (double)FileStorage(streamDir + "/gt/depth/depth.yml",
+                                                   FileStorage::READ)["scale"];
+    EXPECT_LE(scaleStream, scaleMem) << "the bound is at least the largest depth";
+    int compared = 0;
+    for (const std::string& rel : files)
+    {
+        const std::string a = memDir + "/" + rel, b = streamDir + "/" + rel;
+        ASSERT_TRUE(fs::exists(b)) << rel;
+        const std::string ext = fs::path(rel).extension().string();
+        if (rel.rfind("gt/depth/", 0) == 0 && ext == ".png")
+        {
+            // Same zeros; z within the coarser step (values are rounded to 1 / scale).
+            Mat za, zb;
+            imread(a, IMREAD_UNCHANGED).convertTo(za, CV_64F, 1 / scaleMem);
+            imread(b, IMREAD_UNCHANGED).convertTo(zb, CV_64F, 1 / scaleStream);
+            EXPECT_EQ(cv::norm((za == 0) != (zb == 0), NORM_INF), 0) << rel;
+            EXPECT_LE(cv::norm(za, zb, NORM_INF), 0.5 / scaleStream + 0.5 / scaleMem + 1e-9)
+                << rel;
+            compared++;
+        }
+        else if (ext == ".png")
+        {
+            const Mat ia = imread(a, IMREAD_UNCHANGED), ib = imread(b, IMREAD_UNCHANGED);
+            ASSERT_FALSE(ia.empty()) << rel;
+            ASSERT_EQ(ia.size(), ib.size()) << rel;
+            EXPECT_EQ(cv::norm(ia, ib, NORM_INF), 0) << rel;
+            compared++;
+        }
+        else if (ext == ".yml" && rel != "gt/depth/depth.yml")
+        {
+            EXPECT_EQ(text(a), text(b)) << rel;
+            compared++;
+        }
+    }
+    EXPECT_GT(compared, 10 * 9) << "frames, labels, depth and masks of every frame";
+    VideoCapture va(memDir + "/video.mp4"), vb(streamDir + "/video.mp4");
+    EXPECT_EQ(va.get(CAP_PROP_FRAME_COUNT), vb.get(CAP_PROP_FRAME_COUNT));
+    fs::remove_all(root);
 }
 
 TEST(Augocc_SceneSynthesizer, multithread_reproducibility)

@@ -71,21 +71,24 @@ std::vector<double> parseDistortion(const std::string& s)
     return d;
 }
 
-Mat contactSheet(const SyntheticScene& scene)
+// The frames are rendered again (the data set is written as rendered, not held).
+Mat contactSheet(const SceneSynthesizer& synth)
 {
-    const int F = (int)scene.frames.size();
+    const int F = synth.getParams().frames;
     const int n = std::min(kSheetFrames, F);
     std::vector<Mat> images;
     std::vector<String> captions;
     for (int k = 0; k < n; k++)
     {
         const int f = n > 1 ? (int)std::lround((double)k * (F - 1) / (n - 1)) : 0;
-        Mat img = scene.frames[f].clone();
-        for (size_t i = 0; i < scene.objectNames.size(); i++)
+        Mat img;
+        std::vector<Mat> whole;
+        synth.renderFrame(f, img, noArray(), noArray(), whole);
+        for (size_t i = 0; i < whole.size(); i++)
         {
             const Scalar col = kOutlineColours[i % (sizeof(kOutlineColours) /
                                                     sizeof(kOutlineColours[0]))];
-            drawMaskOutlines(img, scene.wholeMasks.at(scene.objectNames[i]).at(f), col, 2);
+            drawMaskOutlines(img, whole[i], col, 2);
         }
         images.push_back(img);
         captions.push_back(format("frame %d", f));
@@ -162,16 +165,14 @@ void runSynth(const Globals& g, const SynthOptions& o)
         throw UsageError("--out " + o.out + ": cannot create its parent folder: " + ec.message());
     info(g, "synthesizing " + std::to_string(p.frames) + " frames (" + o.model + ", seed " +
                 std::to_string(o.seed) + ")");
-    SyntheticScene scene;
-    synth->synthesize(scene);
-
-    // The whole folder is built under a temporary name and renamed into place: a failure leaves
-    // no partial DIR (an existing DIR is replaced only on success).
-    writeSyntheticScene(o.out, scene, p, progress.callback());
+    // Rendered and written frame by frame (memory does not grow with the shot); the whole
+    // folder is built under a temporary name and renamed into place: a failure leaves no
+    // partial DIR (an existing DIR is replaced only on success).
+    synth->write(o.out);
     progress.finish();
     if (!o.contactSheet.empty())
     {
-        const Mat sheet = contactSheet(scene);
+        const Mat sheet = contactSheet(*synth);
         const fs::path sheetPath(o.contactSheet);
         if (sheetPath.has_parent_path())
             fs::create_directories(sheetPath.parent_path(), ec);

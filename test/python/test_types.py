@@ -2,6 +2,7 @@
 """The contract types' numpy views, keyword Params, errors, callbacks, the GIL and the
 lifetime of returned arrays, the synthesizer and the silhouette editor."""
 import gc
+import os
 import sys
 import threading
 import time
@@ -163,6 +164,20 @@ def test_synthesizer(shot):
     img = synth.renderWithVirtual(3, [box])
     assert img.shape == (120, 160, 3) and not np.array_equal(img, scene.frames[3])
     assert len(scene.depth) == 12 and scene.depth[0].dtype == np.float32
+
+
+def test_synthesizer_write_streams(shot, tmp_path):
+    # write() renders frame by frame: the same frames and masks as synthesize() holds.
+    synth, scene = shot["synth"], shot["scene"]
+    synth.write(str(tmp_path / "data"))
+    for f in (0, 11):
+        frame = cv2.imread(str(tmp_path / "data" / "frames" / ("%04d.png" % f)))
+        assert np.array_equal(frame, scene.frames[f])
+        mask = cv2.imread(str(tmp_path / "data" / "gt" / "masks" / "tower" / ("%04d.png" % f)),
+                          cv2.IMREAD_UNCHANGED)
+        assert np.array_equal(mask, scene.wholeMasks["tower"][f])
+    assert sorted(os.listdir(tmp_path / "data" / "input" / "masks" / "lblock")) == [
+        "%04d.png" % f for f in scene.keyFrames]
 
 
 def test_silhouette_editor_headless(shot):

@@ -1110,6 +1110,10 @@ PYBIND11_MODULE(augocc, m)
                  py::gil_scoped_release nogil;
                  s.synthesize(*scene);
                  return scene; }, "The whole sequence with its ground truth.")
+        .def("write", [](const SceneSynthesizer& s, const String& dir) {
+                 py::gil_scoped_release nogil;
+                 s.write(dir); }, py::arg("dir"),
+             "Writes the data set as `augocc synth` does, frame by frame (bounded memory).")
         .def("renderFrame", [](const SceneSynthesizer& s, int frame) {
                  Mat img;
                  {

@@ -13,6 +13,7 @@
 #include "gl_context.hpp"
 #include "shading.hpp"
 #include "shadow.hpp"
+#include "synthetic_scene_io.hpp"
 
 #include <cfloat>
 #include <memory>
@@ -1317,25 +1318,15 @@ public:
         std::vector<std::vector<Mat>> whole(F);
         for (int f = 0; f < F; f++)
         {
-            PassOutputs out;
-            out.bgr = &scene.frames[f];
-            out.labels = &scene.labels[f];
-            out.depth = &scene.depth[f];
-            out.whole = &whole[f];
-            out.shadow = realShadow(gl, m);
-            renderView(gl, m, m.cameras[f], p_.imageSize, p_.frameSupersample, {}, {}, out);
-            applyGains(scene.frames[f], frameGains(p_, f));
+            render(gl, m, f, &scene.frames[f], &scene.labels[f], &scene.depth[f], &whole[f]);
             detail::reportProgress(p_.progress, "synth", "render", f + 1, F, "frames");
         }
         // Visible masks from the labels (CPU, parallel over frames: each writes its own masks).
-        std::vector<std::vector<Mat>> visible(F, std::vector<Mat>(nObj));
+        std::vector<std::vector<Mat>> visible(F);
         parallel_for_(Range(0, F), [&](const Range& r) {
             for (int f = r.start; f < r.end; f++)
-                for (size_t i = 0; i < nObj; i++)
-                    cv::compare(scene.labels[f], Scalar((double)(i + 1)), visible[f][i], CMP_EQ);
+                visible[f] = visibleMasks(scene.labels[f], nObj);
         });
-        scene.objectNames = m.names;
-        scene.objectMeshes = m.objects;
         for (size_t i = 0; i < nObj; i++)
         {
             FrameMasks& w = scene.wholeMasks[m.names[i]];
@@ -1346,15 +1337,37 @@ public:
                 v[f] = visible[f][i];
             }
         }
-        for (int k = 0; k < p_.numKeyFrames; k++)
-            scene.keyFrames.push_back(cvRound((double)k * (F - 1) / (p_.numKeyFrames - 1)));
-        for (size_t i = 0; i < nObj; i++)
-            for (int f : scene.keyFrames)
-                scene.keyFrameMasks[m.names[i]][f] = visible[f][i].clone();
-        scene.groundTruth.model = p_.model;
-        scene.groundTruth.imageSize = p_.imageSize;
-        scene.groundTruth.cameras = m.cameras;
-        makeTracks(p_, m, scene.labels[F / 2], scene.depth[F / 2], scene);
+        finishScene(m, scene.labels[F / 2], scene.depth[F / 2],
+                    [&](int f) { return visible[f]; }, scene);
+    }
+
+    void write(const String& dir) const CV_OVERRIDE
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        const SceneModel& m = model();
+        GlScene& gl = glScene();
+        const int F = p_.frames;
+        const size_t nObj = m.objects.size();
+        // The truth that is not per frame first: the tracks are sampled on the middle frame,
+        // the key-frame masks rendered (the frames are rendered again below, identically).
+        SyntheticScene scene;
+        Mat midLabels, midDepth;
+        render(gl, m, F / 2, nullptr, &midLabels, &midDepth, nullptr);
+        finishScene(m, midLabels, midDepth, [&](int f) {
+            Mat labels;
+            render(gl, m, f, nullptr, &labels, nullptr, nullptr);
+            return visibleMasks(labels, nObj);
+        }, scene);
+        // Every finite depth is within the scene's bounds (depth is affine in the point).
+        double maxDepth = 0;
+        for (const Camera& cam : m.cameras)
+            for (const Vec3f& c : m.boundCorners)
+                maxDepth = std::max(maxDepth, cam.depth(Vec3d(c)));
+        detail::writeSyntheticScene(dir, scene, p_, F, maxDepth,
+                                    [&](int f, detail::SyntheticFrame& out) {
+            render(gl, m, f, &out.bgr, &out.labels, &out.depth, &out.whole);
+            out.visible = visibleMasks(out.labels, nObj);
+        }, p_.progress);
     }
 
     void renderWithVirtual(int frame, const std::vector<Mesh>& virtualObjects, OutputArray image,
@@ -1416,17 +1429,8 @@ public:
         GlScene& gl = glScene();
         Mat bgr, lab, dep;
         std::vector<Mat> whole;
-        PassOutputs out;
-        out.bgr = &bgr;
-        if (labels.needed())
-            out.labels = &lab;
-        if (depth.needed())
-            out.depth = &dep;
-        if (wholeMasks.needed())
-            out.whole = &whole;
-        out.shadow = realShadow(gl, m);
-        renderView(gl, m, m.cameras[frame], p_.imageSize, p_.frameSupersample, {}, {}, out);
-        applyGains(bgr, frameGains(p_, frame));
+        render(gl, m, frame, &bgr, labels.needed() ? &lab : nullptr,
+               depth.needed() ? &dep : nullptr, wholeMasks.needed() ? &whole : nullptr);
         bgr.copyTo(image);
         if (labels.needed())
             lab.copyTo(labels);
@@ -1494,6 +1498,51 @@ private:
             gl.realShadowReady = true;
         }
         return &gl.realShadow;
+    }
+
+    // One frame as synthesize() renders it (any output may be null); callers hold mutex_.
+    void render(GlScene& gl, const SceneModel& m, int f, Mat* bgr, Mat* labels, Mat* depth,
+                std::vector<Mat>* whole) const
+    {
+        Mat colour;
+        PassOutputs out;
+        out.bgr = bgr ? bgr : &colour;
+        out.labels = labels;
+        out.depth = depth;
+        out.whole = whole;
+        out.shadow = realShadow(gl, m);
+        renderView(gl, m, m.cameras[f], p_.imageSize, p_.frameSupersample, {}, {}, out);
+        if (bgr)
+            applyGains(*bgr, frameGains(p_, f));
+    }
+    static std::vector<Mat> visibleMasks(const Mat& labels, size_t nObj)
+    {
+        std::vector<Mat> v(nObj);
+        for (size_t i = 0; i < nObj; i++)
+            cv::compare(labels, Scalar((double)(i + 1)), v[i], CMP_EQ);
+        return v;
+    }
+    // The truth that is not per frame: objects, key frames and their masks (`visibleIn(f)`:
+    // the visible masks of frame f), cameras, tracks (sampled on the middle frame).
+    void finishScene(const SceneModel& m, const Mat& midLabels, const Mat& midDepth,
+                     const std::function<std::vector<Mat>(int)>& visibleIn,
+                     SyntheticScene& scene) const
+    {
+        const int F = p_.frames;
+        scene.objectNames = m.names;
+        scene.objectMeshes = m.objects;
+        for (int k = 0; k < p_.numKeyFrames; k++)
+            scene.keyFrames.push_back(cvRound((double)k * (F - 1) / (p_.numKeyFrames - 1)));
+        for (int f : scene.keyFrames)
+        {
+            const std::vector<Mat> visible = visibleIn(f);
+            for (size_t i = 0; i < m.objects.size(); i++)
+                scene.keyFrameMasks[m.names[i]][f] = visible[i].clone();
+        }
+        scene.groundTruth.model = p_.model;
+        scene.groundTruth.imageSize = p_.imageSize;
+        scene.groundTruth.cameras = m.cameras;
+        makeTracks(p_, m, midLabels, midDepth, scene);
     }
 
     Params p_;

@@ -7,6 +7,8 @@
 #include "precomp.hpp"
 
 #include "atomic_write.hpp"
+#include "synthetic_scene_io.hpp"
+#include "video_out.hpp"
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -35,26 +37,6 @@ const int kWriteBatch = 8;
 void writeImage(const String& path, const Mat& img)
 {
     detail::writeImageFile(path, img, path);
-}
-
-void writeVideo(const String& path, const std::vector<Mat>& frames)
-{
-    detail::checkCreatable(path, path);
-    // H.264 first (plays everywhere), MPEG-4 part 2 when this FFmpeg has no H.264 encoder.
-    VideoWriter writer;
-    for (const char* cc : {"avc1", "H264", "mp4v"})
-    {
-        writer.open(path, VideoWriter::fourcc(cc[0], cc[1], cc[2], cc[3]), kVideoFps,
-                    frames[0].size());
-        if (writer.isOpened())
-            break;
-    }
-    if (!writer.isOpened())
-        CV_Error(Error::StsError, path + ": no video encoder (H.264 or MPEG-4) could be opened");
-    for (const Mat& f : frames)
-        writer.write(f);
-    writer.release();
-    detail::checkVideoFile(path, (int)frames.size(), path);
 }
 
 /* video.mp4 at a set bit rate: H.264 by libx264 through the `ffmpeg` tool (Debian's ffmpeg,
@@ -127,53 +109,47 @@ void writeCalibration(const String& path, const Camera& cam, Size size)
     }, path);
 }
 
-// Depth as 16-bit PNG: value = round(z * scale), 0 where nothing; scale a power of ten chosen so
-// that the farthest depth fits, written to depth.yml beside the images.
-void writeDepth(const fs::path& dir, const std::vector<Mat>& depth)
+/* Depth as 16-bit PNG: value = round(z * scale), 0 where nothing; scale a power of ten chosen so
+that the farthest depth fits with 1 to 10 times headroom (the defaults: 100, 1 cm steps), written
+to depth.yml beside the images. `maxDepth` bounds the depths: their maximum when the whole scene
+is in memory; when it is written as rendered, the farthest corner of the scene's bounds from any
+camera, which can cost one decade of precision. */
+double depthScale(double maxDepth)
 {
-    fs::create_directories(dir);
-    double maxZ = 0;
-    for (const Mat& d : depth)
-        for (int y = 0; y < d.rows; y++)
-        {
-            const float* row = d.ptr<float>(y);
-            for (int x = 0; x < d.cols; x++)
-                if (std::isfinite(row[x]))
-                    maxZ = std::max(maxZ, (double)row[x]);
-        }
     double scale = 1;
-    while (maxZ * scale * 10 < 65000 && scale < 1e6)
+    while (maxDepth * scale * 10 < 65000 && scale < 1e6)
         scale *= 10;
-    while (maxZ * scale >= 65000 && scale > 1e-6)
+    while (maxDepth * scale >= 65000 && scale > 1e-6)
         scale /= 10;
-    detail::writeStorageFile((dir / "depth.yml").string(), [&](FileStorage& fs) {
-        fs << "scale" << scale;
-        fs << "description" << "camera-space z = value / scale; 0 = nothing (infinite)";
-    }, (dir / "depth.yml").string());
-    parallel_for_(Range(0, (int)depth.size()), [&](const Range& r) {
-        for (int f = r.start; f < r.end; f++)
-        {
-            Mat z = depth[f].clone();
-            z.setTo(0, z == std::numeric_limits<float>::infinity());
-            Mat png;
-            z.convertTo(png, CV_16U, scale);
-            writeImage((dir / format("%04d.png", f)).string(), png);
-        }
-    });
+    return scale;
+}
+
+void writeDepthImage(const String& path, const Mat& depth, double scale)
+{
+    Mat z = depth.clone();
+    z.setTo(0, z == std::numeric_limits<float>::infinity());
+    Mat png;
+    z.convertTo(png, CV_16U, scale);
+    writeImage(path, png);
 }
 
 } // namespace
 
+namespace detail {
+
 void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
-                         const SceneSynthesizer::Params& p,
+                         const SceneSynthesizer::Params& p, int F, double maxDepth,
+                         const std::function<void(int, SyntheticFrame&)>& frame,
                          const ProgressCallback& progress)
 {
-    const int F = (int)scene.frames.size();
-    if (F == 0)
+    if (F <= 0)
         CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: the scene has no frame");
-    if ((int)scene.labels.size() != F || (int)scene.depth.size() != F)
-        CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: frames, labels and depth differ "
-                 "in count");
+    for (const String& name : scene.objectNames)
+        if (name.empty() || name.find('/') != String::npos)
+            CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: invalid object name '" +
+                     name + "'");
+    const size_t nObj = scene.objectNames.size();
+    const double scale = depthScale(maxDepth);
     String staged;  // the temporary folder writeAtomically builds DIR in
     try
     {
@@ -183,40 +159,77 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
         writeAtomically(dir, [&](const String& tmpPath) {
             staged = tmpPath;
             const fs::path tmp(tmpPath);
-            fs::create_directories(tmp / "frames");
-            fs::create_directories(tmp / "gt" / "labels");
-            // PNG encoding dominates: frames and labels in parallel (each chunk its own files).
+            for (const char* sub : {"frames", "gt/labels", "gt/depth"})
+                fs::create_directories(tmp / sub);
+            for (const char* sub : {"gt/masks", "gt/visible_masks"})
+                for (const String& name : scene.objectNames)
+                    fs::create_directories(tmp / sub / name);
+            const String videoPath = (tmp / "video.mp4").string();
+            VideoWriter video;  // without a bit rate: fed as the frames come
+            // A batch rendered from this thread, then its PNGs encoded in parallel (encoding
+            // dominates; each frame its own files): memory holds one batch.
+            std::vector<SyntheticFrame> batch(kWriteBatch);
             for (int start = 0; start < F; start += kWriteBatch)
             {
                 const int end = std::min(F, start + kWriteBatch);
+                for (int f = start; f < end; f++)
+                {
+                    SyntheticFrame& out = batch[f - start];
+                    out = SyntheticFrame();
+                    frame(f, out);
+                    if (out.whole.size() != nObj || out.visible.size() != nObj)
+                        CV_Error(Error::StsBadArg, cv::format("%s: writeSyntheticScene: frame "
+                                 "%d has masks of %d / %d objects, expected %d", dir.c_str(), f,
+                                 (int)out.whole.size(), (int)out.visible.size(), (int)nObj));
+                }
                 parallel_for_(Range(start, end), [&](const Range& r) {
                     for (int f = r.start; f < r.end; f++)
                     {
-                        writeImage((tmp / "frames" / format("%04d.png", f)).string(),
-                                   scene.frames[f]);
-                        writeImage((tmp / "gt" / "labels" / format("%04d.png", f)).string(),
-                                   scene.labels[f]);
+                        const SyntheticFrame& in = batch[f - start];
+                        const String name = format("%04d.png", f);
+                        writeImage((tmp / "frames" / name).string(), in.bgr);
+                        writeImage((tmp / "gt" / "labels" / name).string(), in.labels);
+                        writeDepthImage((tmp / "gt" / "depth" / name).string(), in.depth, scale);
+                        for (size_t i = 0; i < nObj; i++)
+                        {
+                            writeImage((tmp / "gt" / "masks" / scene.objectNames[i] /
+                                        name).string(), in.whole[i]);
+                            writeImage((tmp / "gt" / "visible_masks" / scene.objectNames[i] /
+                                        name).string(), in.visible[i]);
+                        }
                     }
                 });
+                if (p.videoBitrateMbps <= 0)
+                    for (int f = start; f < end; f++)
+                    {
+                        if (!video.isOpened())
+                            video = openVideo(videoPath, videoPath, kVideoFps,
+                                              batch[f - start].bgr.size());
+                        video.write(batch[f - start].bgr);
+                    }
                 detail::reportProgress(progress, "synth", "write", end, F, "frames");
             }
+            batch.clear();
             if (p.videoBitrateMbps > 0)
-                writeVideoAtBitrate(tmp / "frames", (tmp / "video.mp4").string(), F,
-                                    p.videoBitrateMbps);
+                writeVideoAtBitrate(tmp / "frames", videoPath, F, p.videoBitrateMbps);
             else
-                writeVideo((tmp / "video.mp4").string(), scene.frames);
+            {
+                video.release();
+                checkVideoFile(videoPath, F, videoPath);
+            }
+            detail::writeStorageFile((tmp / "gt" / "depth" / "depth.yml").string(),
+                                     [&](FileStorage& fs) {
+                fs << "scale" << scale;
+                fs << "description" << "camera-space z = value / scale; 0 = nothing (infinite)";
+            }, (tmp / "gt" / "depth" / "depth.yml").string());
             if (scene.groundTruth.model == PERSPECTIVE && !scene.groundTruth.cameras.empty())
                 writeCalibration((tmp / "calibration.yml").string(),
                                  scene.groundTruth.cameras.front(), scene.groundTruth.imageSize);
             fs::create_directories(tmp / "input");
-            fs::create_directories(tmp / "gt");
             writeMasks((tmp / "input" / "masks").string(), scene.keyFrameMasks);
-            writeMasks((tmp / "gt" / "masks").string(), scene.wholeMasks);
-            writeMasks((tmp / "gt" / "visible_masks").string(), scene.visibleMasks);
             writeReconstruction((tmp / "gt" / "reconstruction.yml").string(), scene.groundTruth);
             writeTracks((tmp / "tracks.yml").string(), scene.tracks);
             writeTracks((tmp / "gt" / "clean_tracks.yml").string(), scene.cleanTracks);
-            writeDepth(tmp / "gt" / "depth", scene.depth);
             fs::create_directories(tmp / "gt" / "meshes");
             for (size_t i = 0; i < scene.objectNames.size(); i++)
                 writeMeshPly((tmp / "gt" / "meshes" / (scene.objectNames[i] + ".ply")).string(),
@@ -267,6 +280,50 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
             msg.replace(at, staged.size(), dir);
         CV_Error(e.code, msg);
     }
+}
+
+} // namespace detail
+
+void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
+                         const SceneSynthesizer::Params& p,
+                         const ProgressCallback& progress)
+{
+    const int F = (int)scene.frames.size();
+    if ((int)scene.labels.size() != F || (int)scene.depth.size() != F)
+        CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: frames, labels and depth differ "
+                 "in count");
+    double maxDepth = 0;
+    for (const Mat& d : scene.depth)
+        for (int y = 0; y < d.rows; y++)
+        {
+            const float* row = d.ptr<float>(y);
+            for (int x = 0; x < d.cols; x++)
+                if (std::isfinite(row[x]))
+                    maxDepth = std::max(maxDepth, (double)row[x]);
+        }
+    // Headers of the scene's own images: nothing is copied.
+    auto maskOf = [&](const ObjectMasks& masks, const String& name, int f) -> Mat {
+        const auto obj = masks.find(name);
+        if (obj != masks.end())
+        {
+            const auto m = obj->second.find(f);
+            if (m != obj->second.end())
+                return m->second;
+        }
+        CV_Error(Error::StsBadArg, cv::format("%s: writeSyntheticScene: no mask of '%s' in "
+                 "frame %d", dir.c_str(), name.c_str(), f));
+    };
+    detail::writeSyntheticScene(dir, scene, p, F, maxDepth,
+                                [&](int f, detail::SyntheticFrame& out) {
+        out.bgr = scene.frames[f];
+        out.labels = scene.labels[f];
+        out.depth = scene.depth[f];
+        for (const String& name : scene.objectNames)
+        {
+            out.whole.push_back(maskOf(scene.wholeMasks, name, f));
+            out.visible.push_back(maskOf(scene.visibleMasks, name, f));
+        }
+    }, progress);
 }
 
 } // namespace augocc

@@ -231,6 +231,16 @@ public:
     //! Synthesizes the whole sequence with its ground truth.
     virtual void synthesize(SyntheticScene& scene) const = 0;
 
+    /** @brief Writes the data set to a folder as writeSyntheticScene() does, rendering it frame
+    by frame: memory holds a few frames, not the shot (a 1280x720 shot of 1800 frames held whole
+    needs about 16 GB). The files are those synthesize() + writeSyntheticScene() write, except
+    the 16-bit depth's scale (gt/depth/depth.yml), chosen from the scene's bounds rather than
+    the depths rendered (it may be one power of ten smaller). Progress: stage "synth", step
+    "write", frames written (Params::progress).
+    @param dir output folder, built under a temporary name and renamed into place.
+    */
+    virtual void write(const String& dir) const = 0;
+
     /** @brief Renders one frame of the sequence with virtual objects inserted using the true
     geometry (the compositor's ground truth). Under Params::sun the virtual objects are
     rendered as if real: lit by the sun, they cast shadows onto the ground, the real objects and
