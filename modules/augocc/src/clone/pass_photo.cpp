@@ -126,10 +126,14 @@ std::vector<int> sweepCameras(const VoxelGrid& g, int axis, int sign, const Phot
 // constraint, the only possible occluders) and no other clone covers its centre pixel nearer
 // than the tolerance. Inconsistent voxels go (KeyFrameCoverage permitting); carving exposes the
 // voxels behind them in the plane, which are checked in turn, then the plane's kept surface is
-// drawn into the cameras' cover maps. Returns the number of voxels carved.
+// drawn into the cameras' cover maps. `surface` (packed voxels, every surface voxel of the
+// grid, possibly carved ones too) is where a plane's candidates come from, so that the sweep's
+// cost follows the surface, not the volume (scanning every plane for its surface voxels took a
+// third of the sweeps' time at 1080p); the voxels carving brings to the surface are added to it.
+// Returns the number of voxels carved.
 int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
             const PhotoObjectViews& ov, KeyFrameCoverage& cov,
-            const CloneBuilder::PhotoParams& p)
+            const CloneBuilder::PhotoParams& p, std::vector<uint32_t>& surface)
 {
     const int nv = (int)cams.size();
     std::vector<Mat> cover(nv);
@@ -212,27 +216,48 @@ int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
             body(Range(0, (int)work.size()));
     };
 
+    // The surface voxels by plane (carving only removes voxels and brings others to the
+    // surface: a plane's surface when its turn comes is its bucket plus what was exposed).
+    std::vector<std::vector<uint32_t>> bucket(np);
+    {
+        size_t alive = 0;
+        for (uint32_t v : surface)
+        {
+            int w[3];
+            unpackVoxel(v, w[0], w[1], w[2]);
+            if (!g.data[g.index(w[0], w[1], w[2])])
+                continue;  // carved by an earlier sweep
+            surface[alive++] = v;
+            bucket[w[axis]].push_back(v);
+        }
+        surface.resize(alive);
+    }
     std::vector<Vec3i> work, next, kept;
     std::vector<uchar> carve;
+    std::vector<std::pair<int, uint32_t>> order;
     for (int s = 0; s < np; s++)
     {
         const int plane = sign > 0 ? s : np - 1 - s;
         std::fill(mark.begin(), mark.end(), 0);
         work.clear();
         kept.clear();
-        for (int b = 0; b < n2; b++)
-            for (int a = 0; a < n1; a++)
-            {
-                Vec3i w;
-                w[axis] = plane;
-                w[a1] = a;
-                w[a2] = b;
-                if (g.data[g.index(w[0], w[1], w[2])] && cov.isSurface(w[0], w[1], w[2]))
-                {
-                    work.push_back(w);
-                    mark[(size_t)b * n1 + a] = 1;
-                }
-            }
+        // In the plane's scan order (a2 outer, a1 inner), as the carving's outcome depends on it.
+        order.clear();
+        for (uint32_t v : bucket[plane])
+        {
+            int w[3];
+            unpackVoxel(v, w[0], w[1], w[2]);
+            order.emplace_back(w[a2] * n1 + w[a1], v);
+        }
+        std::vector<uint32_t>().swap(bucket[plane]);
+        std::sort(order.begin(), order.end());
+        for (const auto& o : order)
+        {
+            Vec3i w;
+            unpackVoxel(o.second, w[0], w[1], w[2]);
+            work.push_back(w);
+            mark[o.first] = 1;
+        }
         while (!work.empty())
         {
             evaluate(work, carve);
@@ -246,6 +271,13 @@ int64 sweep(VoxelGrid& g, int axis, int sign, const std::vector<int>& cams,
                     continue;
                 }
                 carved++;
+                for (const Vec3i& e : cov.exposed())
+                {
+                    const uint32_t packed = packVoxel(e[0], e[1], e[2]);
+                    surface.push_back(packed);
+                    if (sign * (e[axis] - plane) > 0)
+                        bucket[e[axis]].push_back(packed);  // a plane still to come
+                }
                 for (int d = 0; d < 4; d++)
                 {
                     Vec3i u = w;
@@ -379,6 +411,7 @@ int64 passPhoto(ObjectClone& obj, const PassContext& ctx)
     }
     std::sort(order.begin(), order.end());
     int64 n = 0;
+    std::vector<uint32_t> surface = obj.grid.surface().ijk;
     std::vector<std::vector<int> > done;
     for (const auto& d : order)
     {
@@ -388,7 +421,8 @@ int64 passPhoto(ObjectClone& obj, const PassContext& ctx)
         if (std::find(done.begin(), done.end(), cams[d.second]) != done.end())
             continue;
         done.push_back(cams[d.second]);
-        n += sweep(obj.grid, d.second / 2, d.second % 2 ? 1 : -1, cams[d.second], ov, cov, p);
+        n += sweep(obj.grid, d.second / 2, d.second % 2 ? 1 : -1, cams[d.second], ov, cov, p,
+                   surface);
     }
     if (n > 0)
         obj.surface = obj.grid.surface();
