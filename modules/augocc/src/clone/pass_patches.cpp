@@ -287,6 +287,22 @@ std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camer
     Mat covered = zmin.clone();
     std::vector<Point> todo = missing;
     std::vector<uint32_t> accepted;
+    // The candidates, each once: the rays of neighbouring pixels and the samples along a ray
+    // meet the same voxels many times (at 3840x2160, sorting the repeats out took 7% of the
+    // clone stage); a bit per grid cell marks the ones already taken, cleared after each round.
+    std::vector<uint64_t> taken((g.data.size() + 63) / 64, 0);
+    auto take = [&](std::vector<uint32_t>& list, uint32_t v) {
+        int i, j, k;
+        unpackVoxel(v, i, j, k);
+        const size_t idx = g.index(i, j, k);
+        uint64_t& word = taken[idx >> 6];
+        const uint64_t bit = uint64_t(1) << (idx & 63);
+        if (!(word & bit))
+        {
+            word |= bit;
+            list.push_back(v);
+        }
+    };
     for (int round = 0; round <= kPatchExtraRounds && !todo.empty(); round++)
     {
         const int n = raysPerPixel + round;
@@ -313,7 +329,7 @@ std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camer
                         const uint32_t v = nearestFittingVoxel(g, view, a, b, t0, t1, accepted,
                                                                fits);
                         if (v != kNoVoxel)
-                            cand.push_back(v);
+                            take(cand, v);
                         continue;
                     }
                     if (t1 < 0 || t0 > 1)
@@ -337,12 +353,18 @@ std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camer
                         const Vec3d v = a + t * (b - a);
                         const int i = cvRound(v[0]), j = cvRound(v[1]), k = cvRound(v[2]);
                         if (g.inside(i, j, k) && !g.data[g.index(i, j, k)])
-                            cand.push_back(packVoxel(i, j, k));
+                            take(cand, packVoxel(i, j, k));
                     }
                 }
         }
         std::sort(cand.begin(), cand.end());
-        cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+        for (uint32_t c : cand)
+        {
+            int i, j, k;
+            unpackVoxel(c, i, j, k);
+            const size_t idx = g.index(i, j, k);
+            taken[idx >> 6] &= ~(uint64_t(1) << (idx & 63));
+        }
         std::vector<uint32_t> ok;
         for (uint32_t c : cand)
         {
