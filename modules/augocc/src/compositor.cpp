@@ -567,11 +567,18 @@ private:
         }
         realZ_.create(fsz, CV_32F);
         realZ_.setTo(Scalar::all(inf));
+        // Only realZ_(roi) is read below: the clones are drawn over the ROI alone, with the
+        // camera shifted by its corner (the same pixels; a whole 1920x1080 frame per object
+        // before). Through a lens the render's ideal view depends on the image's size: there
+        // the whole frame.
+        const Rect drawn = camera.hasDistortion() ? Rect(Point(), fsz) : roi;
         if (clones)
             for (const String& name : clones->objectNames())
             {
-                clones->render(name, frameIndex, camera, fsz, cloneMatte_, cloneDepth_);
-                cv::min(realZ_, cloneDepth_, realZ_);
+                clones->render(name, frameIndex, shiftedCamera(camera, drawn.tl()), drawn.size(),
+                               cloneMatte_, cloneDepth_);
+                Mat z = realZ_(drawn);
+                cv::min(z, cloneDepth_, z);
             }
         else if (!occ.empty() && occ.size() == fsz)
             occ.copyTo(realZ_);
