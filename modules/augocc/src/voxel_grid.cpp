@@ -839,15 +839,51 @@ Mesh VoxelGrid::cubesMesh(const std::vector<uint32_t>& voxels) const
     return mesh;
 }
 
-void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, size_t n,
-                 bool frontOnly, Mat& zmin, Mat* zmax, Point offset)
+namespace {
+
+// What a splat writes, one footprint row at a time: the nearest (and farthest) centre depth, or
+// only coverage (255), a quarter of the memory, for the mattes that need no depth.
+struct DepthSpans
 {
-    CV_Assert(zmin.type() == CV_32FC1);
-    CV_Assert(!zmax || (zmax->type() == CV_32FC1 && zmax->size() == zmin.size()));
+    Mat& zmin;
+    Mat* zmax;
+    Point offset;
+    bool affineFast() const { return zmax == nullptr; }
+    void span(int y, int x0, int x1, float z) const
+    {
+        float* zr = zmin.ptr<float>(y - offset.y) - offset.x;
+        float* zx = zmax ? zmax->ptr<float>(y - offset.y) - offset.x : nullptr;
+        for (int x = x0; x <= x1; x++)
+        {
+            if (z < zr[x])
+                zr[x] = z;
+            if (zx && z > zx[x])
+                zx[x] = z;
+        }
+    }
+};
+
+struct CoverSpans
+{
+    Mat& cover;
+    Point offset;
+    bool affineFast() const { return true; }
+    void span(int y, int x0, int x1, float) const
+    {
+        if (x1 >= x0)
+            std::memset(cover.ptr<uchar>(y - offset.y) - offset.x + x0, 255, x1 - x0 + 1);
+    }
+};
+
+template <class Spans>
+void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, size_t n,
+           bool frontOnly, Size buffer, const Spans& out)
+{
+    const Point offset = out.offset;
     // Pixels written: the image, intersected with the buffer placed at `offset`.
     const int X0 = std::max(0, offset.x), Y0 = std::max(0, offset.y);
-    const int X1 = std::min(proj.size.width, offset.x + zmin.cols) - 1;
-    const int Y1 = std::min(proj.size.height, offset.y + zmin.rows) - 1;
+    const int X1 = std::min(proj.size.width, offset.x + buffer.width) - 1;
+    const int Y1 = std::min(proj.size.height, offset.y + buffer.height) - 1;
     // Affine: the faces turned to the camera are fixed (outward normal . viewDir < 0).
     uchar frontMask = 0;
     if (proj.affine)
@@ -857,7 +893,7 @@ void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* f
             if (proj.viewDir[a] < 0) frontMask |= (uchar)(1 << (2 * a + 1));
         }
     const bool cull = frontOnly && faces;
-    if (proj.affine && !zmax)
+    if (proj.affine && out.affineFast())
     {
         // The renderer's path: VoxelProjector::footprint's arithmetic term for term (so key
         // frames stay exact), with the row part computed once per voxel row (voxels come sorted).
@@ -887,11 +923,7 @@ void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* f
             const int y1 = std::min(std::max(cvFloor(v + rv), pv), Y1);
             const float z = (float)(proj.Z[0] * i + az);
             for (int y = y0; y <= y1; y++)
-            {
-                float* zr = zmin.ptr<float>(y - offset.y) - offset.x;
-                for (int x = x0; x <= x1; x++)
-                    zr[x] = std::min(zr[x], z);
-            }
+                out.span(y, x0, x1, z);
         }
         return;
     }
@@ -926,18 +958,18 @@ void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* f
         y1 = std::min(y1, Y1);
         const float z = (float)zd;
         for (int y = y0; y <= y1; y++)
-        {
-            float* zr = zmin.ptr<float>(y - offset.y) - offset.x;
-            float* zx = zmax ? zmax->ptr<float>(y - offset.y) - offset.x : nullptr;
-            for (int x = x0; x <= x1; x++)
-            {
-                if (z < zr[x])
-                    zr[x] = z;
-                if (zx && z > zx[x])
-                    zx[x] = z;
-            }
-        }
+            out.span(y, x0, x1, z);
     }
+}
+
+} // namespace
+
+void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, size_t n,
+                 bool frontOnly, Mat& zmin, Mat* zmax, Point offset)
+{
+    CV_Assert(zmin.type() == CV_32FC1);
+    CV_Assert(!zmax || (zmax->type() == CV_32FC1 && zmax->size() == zmin.size()));
+    splat(proj, ijk, faces, n, frontOnly, zmin.size(), DepthSpans{zmin, zmax, offset});
 }
 
 Rect VoxelGrid::imageBounds(const VoxelProjector& proj) const
@@ -995,6 +1027,40 @@ void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
     Mat dst = zmin(roi);
     for (int c = 1; c < chunks; c++)
         cv::min(dst, bufs[c], dst);
+}
+
+void renderCoverage(const VoxelGrid& grid, const VoxelProjector& proj,
+                    const std::vector<VoxelList>& lists, Mat& cover)
+{
+    cover.create(proj.size, CV_8U);
+    cover.setTo(Scalar(0));
+    const Rect roi = grid.imageBounds(proj);
+    if (roi.empty())
+        return;
+    // As renderDepth, a byte per pixel: chunks in their own buffers, merged by or.
+    size_t total = 0;
+    for (const VoxelList& l : lists)
+        total += l.n;
+    const size_t kChunk = 65536;
+    const int chunks = (int)std::min<size_t>((size_t)std::max(1, getNumThreads()),
+                                             total / kChunk + 1);
+    std::vector<Mat> bufs(chunks);
+    parallel_for_(Range(0, chunks), [&](const Range& r) {
+        for (int c = r.start; c < r.end; c++)
+        {
+            Mat b = c == 0 ? cover(roi) : Mat(roi.size(), CV_8U, Scalar(0));
+            for (const VoxelList& l : lists)
+            {
+                const size_t a = l.n * c / chunks, e = l.n * (c + 1) / chunks;
+                splat(proj, l.ijk + a, l.faces ? l.faces + a : nullptr, e - a, l.frontOnly,
+                      b.size(), CoverSpans{b, roi.tl()});
+            }
+            bufs[c] = b;
+        }
+    });
+    Mat dst = cover(roi);
+    for (int c = 1; c < chunks; c++)
+        cv::bitwise_or(dst, bufs[c], dst);
 }
 
 } // namespace detail

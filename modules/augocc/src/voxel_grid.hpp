@@ -231,6 +231,11 @@ parallel over voxel chunks; identical for any thread count. This is the matte/de
 CV_EXPORTS void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
                             const std::vector<VoxelList>& lists, Mat& zmin);
 
+/** @brief The matte renderDepth() implies (CV_8U, 255 where its depth is finite, 0 elsewhere),
+without the depth: a byte per pixel instead of a float. */
+CV_EXPORTS void renderCoverage(const VoxelGrid& grid, const VoxelProjector& proj,
+                               const std::vector<VoxelList>& lists, Mat& cover);
+
 } // namespace detail
 } // namespace augocc
 } // namespace cv

@@ -188,6 +188,17 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
         l.n = it->second.size();
         lists.push_back(l);
     }
+    if (!depth.needed())
+    {
+        // The matte alone (`augocc matte`, the mattes of a composite): coverage, no depth.
+        if (matte.needed())
+        {
+            matte.create(imageSize, CV_8U);
+            Mat m = matte.getMat();
+            renderCoverage(o.grid, proj, lists, m);
+        }
+        return;
+    }
     // Rendered straight into the caller's depth map; the matte only over the grid's bounds.
     Mat zmin;
     if (depth.needed())
