@@ -845,6 +845,8 @@ namespace {
 // only coverage (255), a quarter of the memory, for the mattes that need no depth.
 struct DepthSpans
 {
+    DepthSpans(Mat& zmin_, Point offset_, Mat* zmax_ = nullptr)
+        : zmin(zmin_), zmax(zmax_), offset(offset_) {}
     Mat& zmin;
     Mat* zmax;
     Point offset;
@@ -865,6 +867,7 @@ struct DepthSpans
 
 struct CoverSpans
 {
+    CoverSpans(Mat& cover_, Point offset_) : cover(cover_), offset(offset_) {}
     Mat& cover;
     Point offset;
     bool affineFast() const { return true; }
@@ -969,7 +972,7 @@ void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* f
 {
     CV_Assert(zmin.type() == CV_32FC1);
     CV_Assert(!zmax || (zmax->type() == CV_32FC1 && zmax->size() == zmin.size()));
-    splat(proj, ijk, faces, n, frontOnly, zmin.size(), DepthSpans{zmin, zmax, offset});
+    splat(proj, ijk, faces, n, frontOnly, zmin.size(), DepthSpans(zmin, offset, zmax));
 }
 
 Rect VoxelGrid::imageBounds(const VoxelProjector& proj) const
@@ -992,16 +995,22 @@ Rect VoxelGrid::imageBounds(const VoxelProjector& proj) const
     return Rect(Point(x0, y0), Point(x1 + 1, y1 + 1)) & Rect(Point(0, 0), proj.size);
 }
 
-void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
-                 const std::vector<VoxelList>& lists, Mat& zmin)
+namespace {
+
+/* The renderer over several voxel lists: `out` (`type`, `empty` where no footprint falls) over
+the grid's image bounds. The voxels are split in chunks, each splatted into its own buffer
+(the first straight into `out`), then merged (`merge(dst, buffer)`): the result does not depend
+on the chunking, hence on the thread count. */
+template <class Spans, class Merge>
+void renderChunked(const VoxelGrid& grid, const VoxelProjector& proj,
+                   const std::vector<VoxelList>& lists, Mat& out, int type, const Scalar& empty,
+                   Merge merge)
 {
-    zmin.create(proj.size, CV_32F);
-    zmin.setTo(Scalar(std::numeric_limits<float>::infinity()));
+    out.create(proj.size, type);
+    out.setTo(empty);
     const Rect roi = grid.imageBounds(proj);
     if (roi.empty())
         return;
-    // Split the voxels in chunks, each splatted into its own buffer over the grid's bounds, then
-    // merged by min: the result does not depend on the chunking.
     size_t total = 0;
     for (const VoxelList& l : lists)
         total += l.n;
@@ -1012,55 +1021,37 @@ void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
     parallel_for_(Range(0, chunks), [&](const Range& r) {
         for (int c = r.start; c < r.end; c++)
         {
-            // Chunk 0 splats straight into the output (already +inf), the others into buffers.
-            Mat b = c == 0 ? zmin(roi)
-                           : Mat(roi.size(), CV_32F, Scalar(std::numeric_limits<float>::infinity()));
+            Mat b = c == 0 ? out(roi) : Mat(roi.size(), type, empty);
+            const Spans spans(b, roi.tl());
             for (const VoxelList& l : lists)
             {
                 const size_t a = l.n * c / chunks, e = l.n * (c + 1) / chunks;
-                splatVoxels(proj, l.ijk + a, l.faces ? l.faces + a : nullptr, e - a, l.frontOnly,
-                            b, nullptr, roi.tl());
+                splat(proj, l.ijk + a, l.faces ? l.faces + a : nullptr, e - a, l.frontOnly,
+                      b.size(), spans);
             }
             bufs[c] = b;
         }
     });
-    Mat dst = zmin(roi);
+    Mat dst = out(roi);
     for (int c = 1; c < chunks; c++)
-        cv::min(dst, bufs[c], dst);
+        merge(dst, bufs[c]);
+}
+
+} // namespace
+
+void renderDepth(const VoxelGrid& grid, const VoxelProjector& proj,
+                 const std::vector<VoxelList>& lists, Mat& zmin)
+{
+    renderChunked<DepthSpans>(grid, proj, lists, zmin, CV_32F,
+                              Scalar(std::numeric_limits<float>::infinity()),
+                              [](Mat& dst, const Mat& b) { cv::min(dst, b, dst); });
 }
 
 void renderCoverage(const VoxelGrid& grid, const VoxelProjector& proj,
                     const std::vector<VoxelList>& lists, Mat& cover)
 {
-    cover.create(proj.size, CV_8U);
-    cover.setTo(Scalar(0));
-    const Rect roi = grid.imageBounds(proj);
-    if (roi.empty())
-        return;
-    // As renderDepth, a byte per pixel: chunks in their own buffers, merged by or.
-    size_t total = 0;
-    for (const VoxelList& l : lists)
-        total += l.n;
-    const size_t kChunk = 65536;
-    const int chunks = (int)std::min<size_t>((size_t)std::max(1, getNumThreads()),
-                                             total / kChunk + 1);
-    std::vector<Mat> bufs(chunks);
-    parallel_for_(Range(0, chunks), [&](const Range& r) {
-        for (int c = r.start; c < r.end; c++)
-        {
-            Mat b = c == 0 ? cover(roi) : Mat(roi.size(), CV_8U, Scalar(0));
-            for (const VoxelList& l : lists)
-            {
-                const size_t a = l.n * c / chunks, e = l.n * (c + 1) / chunks;
-                splat(proj, l.ijk + a, l.faces ? l.faces + a : nullptr, e - a, l.frontOnly,
-                      b.size(), CoverSpans{b, roi.tl()});
-            }
-            bufs[c] = b;
-        }
-    });
-    Mat dst = cover(roi);
-    for (int c = 1; c < chunks; c++)
-        cv::bitwise_or(dst, bufs[c], dst);
+    renderChunked<CoverSpans>(grid, proj, lists, cover, CV_8U, Scalar(0),
+                              [](Mat& dst, const Mat& b) { cv::bitwise_or(dst, b, dst); });
 }
 
 } // namespace detail
