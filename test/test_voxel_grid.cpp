@@ -153,6 +153,51 @@ TEST(Augocc_VoxelGrid, codec_roundtrip_and_surface)
 }
 
 // A solid block's matte is its projected outline (hole-free) whatever the view.
+// renderCoverage (mattes without depth) must draw exactly the footprints renderDepth draws:
+// carved blobs (holes, thin parts), the front-facing surface culled as the renderer culls it, a
+// second list drawn whole (patch voxels), both camera models, a grid reaching off the image.
+TEST(Augocc_VoxelGrid, coverage_equals_depth_matte)
+{
+    const Size size(320, 240);
+    RNG rng(11);
+    for (int model = 0; model < 2; model++)
+        for (double az : {0.0, 47.0})
+        {
+            VoxelGrid g;
+            const Matx33d Rb = rotationFromRodrigues(Vec3d(0.2, -0.4, 0.1));
+            const double h = 0.03;
+            const Vec3i dims(120, 110, 100);
+            g.create(dims, Rb, Rb * (Vec3d(-dims[0], -dims[1], -dims[2]) * (0.5 * h)) +
+                                   Vec3d(az > 0 ? 2.0 : 0.0, 0, 0), h, 1);
+            std::vector<CarveView> views;
+            for (int v = 0; v < 3; v++)
+                views.push_back(g.carveView(lookAtCamera((CameraModel)model, 50.0 * v - 40, 20,
+                                                         30, size, 40), blobMask(size, rng)));
+            g.carve(views);
+            const SurfaceVoxels s = g.surface();
+            ASSERT_GT(s.size(), (size_t)1000);
+            std::vector<uint32_t> extra;  // every 7th inside voxel, as a patch list
+            for (size_t q = 0; q < s.size(); q += 7)
+                extra.push_back(s.ijk[q]);
+            std::vector<VoxelList> lists(2);
+            lists[0].ijk = s.ijk.data();
+            lists[0].faces = s.faces.data();
+            lists[0].n = s.size();
+            lists[0].frontOnly = true;
+            lists[1].ijk = extra.data();
+            lists[1].n = extra.size();
+            const Camera cam = lookAtCamera((CameraModel)model, az + 13, 28, 30, size, 40);
+            const VoxelProjector p = g.projector(cam, size);
+            Mat z, cover;
+            renderDepth(g, p, lists, z);
+            renderCoverage(g, p, lists, cover);
+            const Mat fromDepth = z < std::numeric_limits<float>::infinity();
+            EXPECT_GT(countNonZero(cover), 1000) << "model " << model << " az " << az;
+            EXPECT_EQ(cv::norm(cover, fromDepth, NORM_INF), 0) << "model " << model << " az "
+                                                                << az;
+        }
+}
+
 TEST(Augocc_VoxelGrid, splat_is_hole_free)
 {
     const Size size(320, 240);
