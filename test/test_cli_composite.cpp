@@ -247,6 +247,15 @@ TEST_F(Augocc_CliComposite, bad_input_frames_out_of_range)
             {"frame"}, out_));
 }
 
+TEST_F(Augocc_CliComposite, bad_input_output_is_a_pattern)
+{
+    // The inputs take printf patterns; --out is a video or a folder: a pattern made a folder
+    // named "%04d.png".
+    const CliData& d = cliData();
+    EXPECT_TRUE(badInputRejected(compositeArgs(d.video, d.rec, d.scene, out_ + "/%04d.png"),
+                                 {"%04d.png", "pattern", "folder"}, out_));
+}
+
 TEST_F(Augocc_CliComposite, bad_input_reconstruction_does_not_match_video)
 {
     const CliData& d = cliData();

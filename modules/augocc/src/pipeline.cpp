@@ -125,6 +125,13 @@ int compositeSequence(const String& input, const Reconstruction& rec, const Clon
 {
     if (output.empty())
         CV_Error(Error::StsBadArg, "no output given");
+    // The inputs take printf patterns; an output is a video or a folder (of %04d.png): a
+    // pattern here made a folder named after it.
+    if (!detail::isVideoPath(output) &&
+        fs::path(output).filename().string().find('%') != std::string::npos)
+        CV_Error(Error::StsBadArg, output + ": a printf pattern; the composite is written as a "
+                 "video (.mp4, .avi, .mkv, .mov, .m4v) or into a folder as %04d.png: give the "
+                 "folder");
     Ptr<FrameSource> src = FrameSource::open(input);
     const int count = src->count();
     const int first = options.firstFrame;
