@@ -5,6 +5,7 @@
 #include "test_clone_scenes.hpp"
 #include "voxel_grid.hpp"
 #include "clone/clone_codec.hpp"
+#include "clone/key_frame_coverage.hpp"
 
 namespace opencv_test {
 namespace {
@@ -196,6 +197,82 @@ TEST(Augocc_VoxelGrid, coverage_equals_depth_matte)
             EXPECT_EQ(cv::norm(cover, fromDepth, NORM_INF), 0) << "model " << model << " az "
                                                                 << az;
         }
+}
+
+// KeyFrameCoverage::carveInOrder (the free-space pass: key frames' counts in parallel, batches
+// taken back at the first refusal) must carve exactly what tryCarve() one by one carves: a
+// carved block whose silhouettes refuse many carves (every other candidate is in a key frame's
+// silhouette), candidates off the surface and repeated ones.
+TEST(Augocc_VoxelGrid, carve_in_order_equals_one_by_one)
+{
+    const Size size(320, 240);
+    RNG rng(5);
+    for (int model = 0; model < 2; model++)
+    {
+        ObjectClone obj;
+        const double h = 0.04;
+        const Vec3i dims(60, 50, 55);
+        obj.grid.create(dims, Matx33d::eye(), Vec3d(-dims[0], -dims[1], -dims[2]) * (0.5 * h),
+                        h, 1);
+        Reconstruction rec;
+        rec.model = (CameraModel)model;
+        rec.imageSize = size;
+        std::vector<CarveView> views;
+        for (int v = 0; v < 4; v++)
+        {
+            Camera cam = lookAtCamera((CameraModel)model, 45.0 * v - 60, 25, 30, size, 40);
+            cam.frame = v;
+            rec.cameras.push_back(cam);
+            const Mat sil = blobMask(size, rng);
+            obj.masks[v] = sil;
+            views.push_back(obj.grid.carveView(cam, sil));
+        }
+        obj.grid.carve(views);
+        // Candidates: the surface, then inner voxels (off the surface until peeled), repeated.
+        std::vector<Vec3i> cands;
+        const SurfaceVoxels surf = obj.grid.surface();
+        for (uint32_t p : surf.ijk)
+        {
+            int i, j, k;
+            unpackVoxel(p, i, j, k);
+            cands.push_back(Vec3i(i, j, k));
+        }
+        for (int q = 0; q < 20000; q++)
+            cands.push_back(cands[(size_t)rng.uniform(0, (int)cands.size())]);
+        ASSERT_GT(surf.size(), (size_t)1000);
+        VoxelGrid gridA = obj.grid, gridB = obj.grid;
+        std::vector<uchar> carvedA(cands.size(), 0);
+        std::vector<std::vector<Vec3i>> exposedA(cands.size());
+        {
+            KeyFrameCoverage cov(gridA, obj, rec);
+            for (size_t n = 0; n < cands.size(); n++)
+            {
+                const Vec3i& v = cands[n];
+                if (!gridA.data[gridA.index(v[0], v[1], v[2])] ||
+                    !cov.isSurface(v[0], v[1], v[2]) || !cov.tryCarve(v[0], v[1], v[2]))
+                    continue;
+                carvedA[n] = 1;
+                exposedA[n] = cov.exposed();
+            }
+        }
+        std::vector<uchar> carvedB;
+        std::vector<std::vector<Vec3i>> exposedB;
+        {
+            KeyFrameCoverage cov(gridB, obj, rec);
+            cov.carveInOrder(cands, carvedB, exposedB);
+        }
+        int carved = 0, refused = 0;
+        for (size_t n = 0; n < cands.size(); n++)
+        {
+            carved += carvedA[n];
+            refused += !carvedA[n] && n < surf.size();
+        }
+        EXPECT_GT(carved, 1000) << "model " << model;
+        EXPECT_GT(refused, 100) << "model " << model << ": the key frames must refuse some";
+        EXPECT_TRUE(carvedA == carvedB) << "model " << model;
+        EXPECT_TRUE(exposedA == exposedB) << "model " << model;
+        EXPECT_TRUE(gridA.data == gridB.data) << "model " << model;
+    }
 }
 
 TEST(Augocc_VoxelGrid, splat_is_hole_free)

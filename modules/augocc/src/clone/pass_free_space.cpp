@@ -288,7 +288,8 @@ int64 passFreeSpace(ObjectClone& obj, const PassContext& ctx)
     }
     KeyFrameCoverage cov(g, obj, rec);
     int64 n = 0;
-    std::vector<uchar> answer;
+    std::vector<uchar> answer, carved;
+    std::vector<std::vector<Vec3i>> exposedOf;
     while (!wave.empty())
     {
         answer.assign(wave.size(), 0);
@@ -296,15 +297,19 @@ int64 passFreeSpace(ObjectClone& obj, const PassContext& ctx)
             for (int q = r.start; q < r.end; q++)
                 answer[q] = isFree(wave[q][0], wave[q][1], wave[q][2]);
         });
-        std::vector<Vec3i> next;
+        // The free voxels carved in the wave's order (the key frames' counts in parallel).
+        std::vector<Vec3i> cands;
         for (size_t q = 0; q < wave.size(); q++)
+            if (answer[q])
+                cands.push_back(wave[q]);
+        cov.carveInOrder(cands, carved, exposedOf);
+        std::vector<Vec3i> next;
+        for (size_t q = 0; q < cands.size(); q++)
         {
-            const Vec3i& v = wave[q];
-            if (!answer[q] || !g.data[g.index(v[0], v[1], v[2])] ||
-                !cov.isSurface(v[0], v[1], v[2]) || !cov.tryCarve(v[0], v[1], v[2]))
+            if (!carved[q])
                 continue;
             n++;
-            for (const Vec3i& e : cov.exposed())
+            for (const Vec3i& e : exposedOf[q])
             {
                 const size_t idx = g.index(e[0], e[1], e[2]);
                 if (!queued[idx])
