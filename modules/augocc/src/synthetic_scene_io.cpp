@@ -31,8 +31,11 @@ namespace {
 namespace fs = std::filesystem;
 
 const double kVideoFps = 25.0;
-// Frames encoded per parallel batch (progress is reported between batches).
+// Frames rendered, then encoded in parallel, per batch (progress is reported between batches):
+// at most kWriteBatch, and at most kWriteBatchPixels pixels in all (a frame with its truth holds
+// about 14 bytes a pixel: 8 frames of 3840x2160 peaked at 3.2 GB).
 const int kWriteBatch = 8;
+const double kWriteBatchPixels = 8.0 * 1920 * 1080;
 
 void writeImage(const String& path, const Mat& img)
 {
@@ -168,10 +171,13 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
             VideoWriter video;  // without a bit rate: fed as the frames come
             // A batch rendered from this thread, then its PNGs encoded in parallel (encoding
             // dominates; each frame its own files): memory holds one batch.
-            std::vector<SyntheticFrame> batch(kWriteBatch);
-            for (int start = 0; start < F; start += kWriteBatch)
+            const Size frameSize = p.imageSize;
+            const int perBatch = std::max(1, std::min(kWriteBatch, (int)(kWriteBatchPixels /
+                                                      std::max(1.0, (double)frameSize.area()))));
+            std::vector<SyntheticFrame> batch(perBatch);
+            for (int start = 0; start < F; start += perBatch)
             {
-                const int end = std::min(F, start + kWriteBatch);
+                const int end = std::min(F, start + perBatch);
                 for (int f = start; f < end; f++)
                 {
                     SyntheticFrame& out = batch[f - start];
