@@ -1348,25 +1348,31 @@ public:
         GlScene& gl = glScene();
         const int F = p_.frames;
         const size_t nObj = m.objects.size();
-        // The truth that is not per frame first: the tracks are sampled on the middle frame,
-        // the key-frame masks rendered (the frames are rendered again below, identically).
-        SyntheticScene scene;
-        Mat midLabels, midDepth;
-        render(gl, m, F / 2, nullptr, &midLabels, &midDepth, nullptr);
-        finishScene(m, midLabels, midDepth, [&](int f) {
-            Mat labels;
-            render(gl, m, f, nullptr, &labels, nullptr, nullptr);
-            return visibleMasks(labels, nObj);
-        }, scene);
         // Every finite depth is within the scene's bounds (depth is affine in the point).
         double maxDepth = 0;
         for (const Camera& cam : m.cameras)
             for (const Vec3f& c : m.boundCorners)
                 maxDepth = std::max(maxDepth, cam.depth(Vec3d(c)));
-        detail::writeSyntheticScene(dir, scene, p_, F, maxDepth,
+        // What the truth that is not per frame needs is kept as the frames go by: the middle
+        // frame's labels and depth (the tracks are sampled on it), the key frames' masks.
+        const std::vector<int> keys = keyFrames();
+        std::map<int, std::vector<Mat>> keyVisible;
+        Mat midLabels, midDepth;
+        SyntheticScene scene;
+        detail::writeSyntheticScene(dir, m.names, p_, F, maxDepth,
                                     [&](int f, detail::SyntheticFrame& out) {
             render(gl, m, f, &out.bgr, &out.labels, &out.depth, &out.whole);
             out.visible = visibleMasks(out.labels, nObj);
+            if (f == F / 2)
+            {
+                midLabels = out.labels;
+                midDepth = out.depth;
+            }
+            if (std::find(keys.begin(), keys.end(), f) != keys.end())
+                keyVisible[f] = out.visible;
+        }, [&]() -> const SyntheticScene& {
+            finishScene(m, midLabels, midDepth, [&](int f) { return keyVisible.at(f); }, scene);
+            return scene;
         }, p_.progress);
     }
 
@@ -1522,17 +1528,22 @@ private:
             cv::compare(labels, Scalar((double)(i + 1)), v[i], CMP_EQ);
         return v;
     }
+    std::vector<int> keyFrames() const
+    {
+        std::vector<int> keys;
+        for (int k = 0; k < p_.numKeyFrames; k++)
+            keys.push_back(cvRound((double)k * (p_.frames - 1) / (p_.numKeyFrames - 1)));
+        return keys;
+    }
     // The truth that is not per frame: objects, key frames and their masks (`visibleIn(f)`:
     // the visible masks of frame f), cameras, tracks (sampled on the middle frame).
     void finishScene(const SceneModel& m, const Mat& midLabels, const Mat& midDepth,
                      const std::function<std::vector<Mat>(int)>& visibleIn,
                      SyntheticScene& scene) const
     {
-        const int F = p_.frames;
         scene.objectNames = m.names;
         scene.objectMeshes = m.objects;
-        for (int k = 0; k < p_.numKeyFrames; k++)
-            scene.keyFrames.push_back(cvRound((double)k * (F - 1) / (p_.numKeyFrames - 1)));
+        scene.keyFrames = keyFrames();
         for (int f : scene.keyFrames)
         {
             const std::vector<Mat> visible = visibleIn(f);

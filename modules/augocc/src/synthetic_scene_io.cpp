@@ -140,18 +140,19 @@ void writeDepthImage(const String& path, const Mat& depth, double scale)
 
 namespace detail {
 
-void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
+void writeSyntheticScene(const String& dir, const std::vector<String>& names,
                          const SceneSynthesizer::Params& p, int F, double maxDepth,
                          const std::function<void(int, SyntheticFrame&)>& frame,
+                         const std::function<const SyntheticScene&()>& rest,
                          const ProgressCallback& progress)
 {
     if (F <= 0)
         CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: the scene has no frame");
-    for (const String& name : scene.objectNames)
+    for (const String& name : names)
         if (name.empty() || name.find('/') != String::npos)
             CV_Error(Error::StsBadArg, dir + ": writeSyntheticScene: invalid object name '" +
                      name + "'");
-    const size_t nObj = scene.objectNames.size();
+    const size_t nObj = names.size();
     const double scale = depthScale(maxDepth);
     String staged;  // the temporary folder writeAtomically builds DIR in
     try
@@ -165,7 +166,7 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
             for (const char* sub : {"frames", "gt/labels", "gt/depth"})
                 fs::create_directories(tmp / sub);
             for (const char* sub : {"gt/masks", "gt/visible_masks"})
-                for (const String& name : scene.objectNames)
+                for (const String& name : names)
                     fs::create_directories(tmp / sub / name);
             const String videoPath = (tmp / "video.mp4").string();
             VideoWriter video;  // without a bit rate: fed as the frames come
@@ -198,9 +199,9 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
                         writeDepthImage((tmp / "gt" / "depth" / name).string(), in.depth, scale);
                         for (size_t i = 0; i < nObj; i++)
                         {
-                            writeImage((tmp / "gt" / "masks" / scene.objectNames[i] /
-                                        name).string(), in.whole[i]);
-                            writeImage((tmp / "gt" / "visible_masks" / scene.objectNames[i] /
+                            writeImage((tmp / "gt" / "masks" / names[i] / name).string(),
+                                       in.whole[i]);
+                            writeImage((tmp / "gt" / "visible_masks" / names[i] /
                                         name).string(), in.visible[i]);
                         }
                     }
@@ -228,6 +229,7 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
                 fs << "scale" << scale;
                 fs << "description" << "camera-space z = value / scale; 0 = nothing (infinite)";
             }, (tmp / "gt" / "depth" / "depth.yml").string());
+            const SyntheticScene& scene = rest();
             if (scene.groundTruth.model == PERSPECTIVE && !scene.groundTruth.cameras.empty())
                 writeCalibration((tmp / "calibration.yml").string(),
                                  scene.groundTruth.cameras.front(), scene.groundTruth.imageSize);
@@ -300,13 +302,11 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
                  "in count");
     double maxDepth = 0;
     for (const Mat& d : scene.depth)
-        for (int y = 0; y < d.rows; y++)
-        {
-            const float* row = d.ptr<float>(y);
-            for (int x = 0; x < d.cols; x++)
-                if (std::isfinite(row[x]))
-                    maxDepth = std::max(maxDepth, (double)row[x]);
-        }
+    {
+        double lo = 0, hi = 0;
+        minMaxIdx(d, &lo, &hi, nullptr, nullptr, d < std::numeric_limits<float>::infinity());
+        maxDepth = std::max(maxDepth, hi);
+    }
     // Headers of the scene's own images: nothing is copied.
     auto maskOf = [&](const ObjectMasks& masks, const String& name, int f) -> Mat {
         const auto obj = masks.find(name);
@@ -319,7 +319,7 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
         CV_Error(Error::StsBadArg, cv::format("%s: writeSyntheticScene: no mask of '%s' in "
                  "frame %d", dir.c_str(), name.c_str(), f));
     };
-    detail::writeSyntheticScene(dir, scene, p, F, maxDepth,
+    detail::writeSyntheticScene(dir, scene.objectNames, p, F, maxDepth,
                                 [&](int f, detail::SyntheticFrame& out) {
         out.bgr = scene.frames[f];
         out.labels = scene.labels[f];
@@ -329,7 +329,7 @@ void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
             out.whole.push_back(maskOf(scene.wholeMasks, name, f));
             out.visible.push_back(maskOf(scene.visibleMasks, name, f));
         }
-    }, progress);
+    }, [&]() -> const SyntheticScene& { return scene; }, progress);
 }
 
 } // namespace augocc

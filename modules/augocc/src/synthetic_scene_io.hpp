@@ -22,13 +22,15 @@ struct SyntheticFrame
     std::vector<Mat> whole, visible;  // SyntheticScene::objectNames order
 };
 
-/** @brief Writes the data set DIR (writeSyntheticScene's layout). The per-frame files come from
-`frame(f, out)`, called for f = 0, 1, ... in order from the calling thread, a batch at a time
-(memory holds one batch); everything else from `scene`, whose per-frame members are not read.
-`maxDepth` bounds every finite depth: the 16-bit depth's scale follows from it. */
-void writeSyntheticScene(const String& dir, const SyntheticScene& scene,
+/** @brief Writes the data set DIR (writeSyntheticScene's layout) for objects `names`. The
+per-frame files come from `frame(f, out)`, called for f = 0, 1, ... in order from the calling
+thread, a batch at a time (memory holds one batch); everything else from the scene `rest()`
+returns once every frame is written (its per-frame members are not read). `maxDepth` bounds
+every finite depth: the 16-bit depth's scale follows from it. */
+void writeSyntheticScene(const String& dir, const std::vector<String>& names,
                          const SceneSynthesizer::Params& p, int frames, double maxDepth,
                          const std::function<void(int, SyntheticFrame&)>& frame,
+                         const std::function<const SyntheticScene&()>& rest,
                          const ProgressCallback& progress);
 
 } // namespace detail

@@ -200,12 +200,8 @@ void CloneSetImpl::render(const String& object, int frame, const Camera& camera,
         return;
     }
     // Rendered straight into the caller's depth map; the matte only over the grid's bounds.
-    Mat zmin;
-    if (depth.needed())
-    {
-        depth.create(imageSize, CV_32F);
-        zmin = depth.getMat();
-    }
+    depth.create(imageSize, CV_32F);
+    Mat zmin = depth.getMat();
     renderDepth(o.grid, proj, lists, zmin);
     if (matte.needed())
     {

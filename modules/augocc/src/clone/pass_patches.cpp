@@ -291,10 +291,13 @@ std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camer
     // meet the same voxels many times (at 3840x2160, sorting the repeats out took 7% of the
     // clone stage); a bit per grid cell marks the ones already taken, cleared after each round.
     std::vector<uint64_t> taken((g.data.size() + 63) / 64, 0);
-    auto take = [&](std::vector<uint32_t>& list, uint32_t v) {
+    auto cellOf = [&](uint32_t v) {
         int i, j, k;
         unpackVoxel(v, i, j, k);
-        const size_t idx = g.index(i, j, k);
+        return g.index(i, j, k);
+    };
+    auto take = [&](std::vector<uint32_t>& list, uint32_t v) {
+        const size_t idx = cellOf(v);
         uint64_t& word = taken[idx >> 6];
         const uint64_t bit = uint64_t(1) << (idx & 63);
         if (!(word & bit))
@@ -360,9 +363,7 @@ std::vector<uint32_t> computePatches(const ObjectClone& obj, const Camera& camer
         std::sort(cand.begin(), cand.end());
         for (uint32_t c : cand)
         {
-            int i, j, k;
-            unpackVoxel(c, i, j, k);
-            const size_t idx = g.index(i, j, k);
+            const size_t idx = cellOf(c);
             taken[idx >> 6] &= ~(uint64_t(1) << (idx & 63));
         }
         std::vector<uint32_t> ok;
