@@ -199,6 +199,59 @@ TEST(Augocc_VoxelGrid, coverage_equals_depth_matte)
         }
 }
 
+// The splat passes over the voxels of a row whose footprint cannot meet the buffer (bounds per
+// row, both camera models): drawn into a window at an offset, it must equal the window's crop
+// of the whole image's depth, for windows inside, across the image's edges and off it, small
+// ones too, and for a perspective camera close enough that rows cross behind it.
+TEST(Augocc_VoxelGrid, splat_window_equals_crop)
+{
+    const Size size(320, 240);
+    const float inf = std::numeric_limits<float>::infinity();
+    RNG rng(5);
+    for (int model = 0; model < 2; model++)
+        for (double dist : {30.0, 1.0})
+        {
+            if (model == SCALED_ORTHOGRAPHIC && dist < 10)
+                continue;
+            VoxelGrid g;
+            const Matx33d Rb = rotationFromRodrigues(Vec3d(0.3, 0.5, -0.2));
+            const double h = 0.03;
+            const Vec3i dims(90, 100, 80);
+            g.create(dims, Rb, Rb * (Vec3d(-dims[0], -dims[1], -dims[2]) * (0.5 * h)), h, 1);
+            std::vector<CarveView> views;
+            for (int v = 0; v < 3; v++)
+                views.push_back(g.carveView(lookAtCamera((CameraModel)model, 50.0 * v - 40, 20,
+                                                         30, size, 40), blobMask(size, rng)));
+            g.carve(views);
+            const SurfaceVoxels s = g.surface();
+            ASSERT_GT(s.size(), (size_t)1000);
+            const Camera cam = lookAtCamera((CameraModel)model, 23, 31, dist, size,
+                                            dist < 10 ? 120 : 40);
+            const VoxelProjector p = g.projector(cam, size);
+            for (bool front : {true, false})
+            {
+                Mat whole(size, CV_32F, Scalar(inf));
+                splatVoxels(p, s.ijk.data(), s.faces.data(), s.size(), front, whole, nullptr);
+                ASSERT_GT(countNonZero(whole < inf), 2000) << "model " << model;
+                const Rect windows[] = {Rect(100, 70, 60, 50), Rect(-20, -10, 90, 80),
+                                        Rect(280, 200, 100, 100), Rect(150, 120, 3, 2),
+                                        Rect(0, 0, 320, 240), Rect(400, 10, 20, 20)};
+                for (const Rect& w : windows)
+                {
+                    Mat win(w.size(), CV_32F, Scalar(inf));
+                    splatVoxels(p, s.ijk.data(), s.faces.data(), s.size(), front, win, nullptr,
+                                w.tl());
+                    Mat expect(w.size(), CV_32F, Scalar(inf));
+                    const Rect in = w & Rect(Point(), size);
+                    if (!in.empty())
+                        whole(in).copyTo(expect(in - w.tl()));
+                    EXPECT_EQ(countNonZero(win != expect), 0)
+                        << "model " << model << " dist " << dist << " window " << w;
+                }
+            }
+        }
+}
+
 // KeyFrameCoverage::carveInOrder (the free-space pass: key frames' counts in parallel, batches
 // taken back at the first refusal) must carve exactly what tryCarve() one by one carves: a
 // carved block whose silhouettes refuse many carves (every other candidate is in a key frame's

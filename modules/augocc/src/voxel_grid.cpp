@@ -136,6 +136,7 @@ VoxelProjector VoxelGrid::projector(const Camera& camera, Size imageSize) const
     p.size = imageSize;
     p.viewDir = RbT * camera.viewDirection();
     p.camVoxel = toVoxel(camera.center());
+    p.rowLength = dims[0];
     if (p.affine)
     {
         // Half extents of the projected cube: half the sum of |edge projections| (exact).
@@ -878,6 +879,81 @@ struct CoverSpans
     }
 };
 
+/* The voxels i of a grid row whose affine footprint can meet the pixels [X0, X1] x [Y0, Y1]:
+[iLo, iHi] (empty when iLo > iHi), with a margin. The centre u = mu i + au; the footprint's
+columns lie within [u - ru - 0.5, u + ru + 0.5] (VoxelProjector::footprint: the ceiling of
+u - ru or the rounded centre, the floor of u + ru or the rounded centre), so a voxel is drawn
+only when u lies within [X0 - ru - 0.5, X1 + ru + 0.5]; and the same for the rows. The bounds
+solved for i are widened by one voxel against the rounding of the divisions. */
+void footprintRowRange(double mu, double au, double ru, int X0, int X1, double mv, double av,
+                       double rv, int Y0, int Y1, int& iLo, int& iHi)
+{
+    double lo = -2, hi = 1026;  // every i a packed voxel holds, and a margin
+    auto cut = [&](double m, double a, double r, int P0, int P1) {
+        const double pLo = P0 - r - 1.0, pHi = P1 + r + 1.0;
+        if (!(pLo <= pHi))
+        {
+            hi = lo - 1;
+            return;
+        }
+        if (m == 0)
+        {
+            if (!(a >= pLo && a <= pHi))
+                hi = lo - 1;
+            return;
+        }
+        double t0 = (pLo - a) / m, t1 = (pHi - a) / m;
+        if (t0 > t1)
+            std::swap(t0, t1);
+        lo = std::max(lo, t0 - 1);
+        hi = std::min(hi, t1 + 1);
+    };
+    cut(mu, au, ru, X0, X1);
+    cut(mv, av, rv, Y0, Y1);
+    if (!(lo <= hi))  // also NaN
+    {
+        iLo = 0;
+        iHi = -1;
+        return;
+    }
+    iLo = (int)std::floor(lo);
+    iHi = (int)std::ceil(hi);
+}
+
+/* Perspective: the voxels i of a row (homogeneous centre (m i + a, ., mw i + aw), w > 0 over
+the row) whose centre column u lies within [P0 - r - 1, P1 + r + 1], r a bound of the
+footprint's half width over the row: u >= L is (m - L mw) i + (a - L aw) >= 0 there, linear.
+Widened by one voxel against rounding. */
+void perspectiveRowRange(double m, double a, double r, int P0, int P1, double mw, double aw,
+                         int& iLo, int& iHi)
+{
+    double lo = -2, hi = kMaxGridDim + 3;
+    auto atLeast = [&](double c1, double c0) {  // c1 i + c0 >= 0
+        if (c1 == 0)
+        {
+            if (!(c0 >= 0))
+                hi = lo - 1;
+            return;
+        }
+        const double t = -c0 / c1;
+        if (c1 > 0)
+            lo = std::max(lo, t - 1);
+        else
+            hi = std::min(hi, t + 1);
+    };
+    const double L0 = P0 - r - 1.0, L1 = P1 + r + 1.0;
+    atLeast(m - L0 * mw, a - L0 * aw);    // u >= L0
+    atLeast(L1 * mw - m, L1 * aw - a);    // u <= L1
+    if (!(lo <= hi) || !(L0 <= L1))
+    {
+        iLo = 0;
+        iHi = -1;
+        return;
+    }
+    iLo = (int)std::floor(lo);
+    iHi = (int)std::ceil(hi);
+}
+
 template <class Spans>
 void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, size_t n,
            bool frontOnly, Size buffer, const Spans& out)
@@ -899,11 +975,15 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
     if (proj.affine && out.affineFast())
     {
         // The renderer's path: VoxelProjector::footprint's arithmetic term for term (so key
-        // frames stay exact), with the row part computed once per voxel row (voxels come sorted).
+        // frames stay exact), with the row part computed once per voxel row (voxels come sorted),
+        // and with it the voxels of the row whose footprint can meet the buffer: the others are
+        // passed over without one (half of a 1080p composite's voxels, drawn over the part of
+        // the frame the virtual objects cover).
         const double ru = proj.ruAffine, rv = proj.rvAffine;
         const Matx33d& M = proj.M;
         uint32_t lastRow = ~0u;
         double a0 = 0, a1 = 0, az = 0;
+        int iLo = 0, iHi = -1;
         for (size_t q = 0; q < n; q++)
         {
             if (cull && !(faces[q] & frontMask))
@@ -917,7 +997,10 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
                 a0 = M(0, 1) * j + M(0, 2) * k + proj.c[0];
                 a1 = M(1, 1) * j + M(1, 2) * k + proj.c[1];
                 az = proj.Z[1] * j + proj.Z[2] * k + proj.z0;
+                footprintRowRange(M(0, 0), a0, ru, X0, X1, M(1, 0), a1, rv, Y0, Y1, iLo, iHi);
             }
+            if (i < iLo || i > iHi)
+                continue;
             const double u = M(0, 0) * i + a0, v = M(1, 0) * i + a1;
             const int pu = cvRound(u), pv = cvRound(v);
             const int x0 = std::max(std::min(cvCeil(u - ru), pu), X0);
@@ -930,10 +1013,46 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
         }
         return;
     }
+    const Matx33d& M = proj.M;
+    const double S0 = std::abs(M(0, 0)) + std::abs(M(0, 1)) + std::abs(M(0, 2));
+    const double S1 = std::abs(M(1, 0)) + std::abs(M(1, 1)) + std::abs(M(1, 2));
+    const double S2 = std::abs(M(2, 0)) + std::abs(M(2, 1)) + std::abs(M(2, 2));
+    const int iMax = std::max(0, std::min(proj.rowLength, kMaxGridDim + 1) - 1);
+    uint32_t lastRow = ~0u;
+    int iLo = 0, iHi = -1;
     for (size_t q = 0; q < n; q++)
     {
         int i, j, k;
         unpackVoxel(ijk[q], i, j, k);
+        if (!proj.affine && (ijk[q] >> 10) != lastRow)
+        {
+            // The row's voxels whose footprint can meet the buffer (as in the affine path).
+            // Where the row is in front of the camera (w > 0 at both ends of the grid's row,
+            // hence between), |u| <= max |u w| / min w and the footprint's half width
+            // 0.5 / w sum_a |M(0,a) - u M(2,a)| <= 0.5 (S0 + |u| S2) / min w: a bound for the
+            // whole row; then u w - (X w) >= 0 at the row's bounds is linear in i.
+            lastRow = ijk[q] >> 10;
+            const double b0 = M(0, 1) * j + M(0, 2) * k + proj.c[0];
+            const double b1 = M(1, 1) * j + M(1, 2) * k + proj.c[1];
+            const double b2 = M(2, 1) * j + M(2, 2) * k + proj.c[2];
+            const double wA = b2, wB = M(2, 0) * iMax + b2, wMin = std::min(wA, wB);
+            iLo = 0;
+            iHi = kMaxGridDim;
+            if (wMin > 1e-9)
+            {
+                const double uMax = std::max(std::abs(b0), std::abs(M(0, 0) * iMax + b0)) / wMin;
+                const double vMax = std::max(std::abs(b1), std::abs(M(1, 0) * iMax + b1)) / wMin;
+                const double ruB = 0.5 * (S0 + uMax * S2) / wMin;
+                const double rvB = 0.5 * (S1 + vMax * S2) / wMin;
+                perspectiveRowRange(M(0, 0), b0, ruB, X0, X1, M(2, 0), b2, iLo, iHi);
+                int lo2, hi2;
+                perspectiveRowRange(M(1, 0), b1, rvB, Y0, Y1, M(2, 0), b2, lo2, hi2);
+                iLo = std::max(iLo, lo2);
+                iHi = std::min(iHi, hi2);
+            }
+        }
+        if (!proj.affine && (i < iLo || i > iHi))
+            continue;
         if (cull)
         {
             uchar m = frontMask;

@@ -61,6 +61,7 @@ struct VoxelProjector
     Vec3d viewDir;    //!< affine: viewing direction in voxel coordinates
     Vec3d camVoxel;   //!< perspective: camera centre in voxel coordinates
     double ruAffine = 0, rvAffine = 0;  //!< affine: footprint half extents in pixels
+    int rowLength = kMaxGridDim + 1;    //!< the grid's voxels along i (renderers' row bounds)
 
     /** @brief Pixel (rounded) of the centre of voxel (i, j, k). Returns false when the voxel is
     not in front of the camera. */
