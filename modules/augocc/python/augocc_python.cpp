@@ -645,6 +645,8 @@ PYBIND11_MODULE(augocc, m)
         .def_readwrite("enabled", &CloneBuilder::UnobservedParams::enabled)
         .def_readwrite("views", &CloneBuilder::UnobservedParams::views)
         .def_readwrite("depthTolVoxels", &CloneBuilder::UnobservedParams::depthTolVoxels)
+        .def_readwrite("keepNearSeen", &CloneBuilder::UnobservedParams::keepNearSeen)
+        .def_readwrite("regrowFromUnseen", &CloneBuilder::UnobservedParams::regrowFromUnseen)
         .def_readwrite("maxTiltDeg", &CloneBuilder::UnobservedParams::maxTiltDeg);
     py::class_<CloneBuilder::PhotoParams>(m, "CloneBuilderPhotoParams")
         .def(py::init<>())

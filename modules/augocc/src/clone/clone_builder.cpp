@@ -182,6 +182,11 @@ void CloneBuilderImpl::setParams(const Params& p)
     check(p.unobserved.views >= 1, "unobserved.views", "must be >= 1");
     check(p.unobserved.depthTolVoxels >= 0 && std::isfinite(p.unobserved.depthTolVoxels),
           "unobserved.depthTolVoxels", "must be >= 0");
+    check(p.unobserved.keepNearSeen >= 0 && p.unobserved.keepNearSeen <= 16,
+          "unobserved.keepNearSeen", "must be in [0, 16]");
+    check(p.unobserved.regrowFromUnseen >= p.unobserved.keepNearSeen &&
+              p.unobserved.regrowFromUnseen <= 16,
+          "unobserved.regrowFromUnseen", "must be in [keepNearSeen, 16]");
     check(p.unobserved.maxTiltDeg >= 0 && p.unobserved.maxTiltDeg <= 90,
           "unobserved.maxTiltDeg", "must be in [0, 90]");
     check(p.photo.threshold >= 0 && p.photo.threshold <= 255, "photo.threshold",

@@ -119,6 +119,8 @@ String paramsText(const CloneBuilder::Params& p)
     word(t, "unobserved.enabled", p.unobserved.enabled);
     word(t, "unobserved.views", p.unobserved.views);
     word(t, "unobserved.depthTolVoxels", p.unobserved.depthTolVoxels);
+    word(t, "unobserved.keepNearSeen", p.unobserved.keepNearSeen);
+    word(t, "unobserved.regrowFromUnseen", p.unobserved.regrowFromUnseen);
     word(t, "unobserved.maxTiltDeg", p.unobserved.maxTiltDeg);
     // The photo parameters do not change a part (refine() runs after the merge) but are kept so
     // that parts and merge agree on every option: one rule, no exceptions to remember.

@@ -192,6 +192,13 @@ public:
         //! A surface voxel is seen when its centre is within this many voxel edges of the nearest
         //! clone depth at its pixel. Higher removes less.
         double depthTolVoxels = 1.5;
+        /** An unseen run with a seen one within this many columns across the vertical (at some of
+        its heights) stays, unless regrowFromUnseen gives it back: under a top seen at a grazing
+        angle only some of the top voxels pass the depth test. 0: every unseen run goes. */
+        int keepNearSeen = 1;
+        /** An unseen run within this many columns of an unseen run that keepNearSeen did not keep
+        goes after all (the thin edges of a wide unseen region), at least keepNearSeen. */
+        int regrowFromUnseen = 3;
         //! The vertical must be within this angle (degrees) of a grid axis for the runs to follow
         //! it; else the pass leaves the object alone.
         double maxTiltDeg = 20;
