@@ -31,6 +31,23 @@ Mat blobMask(Size size, RNG& rng)
     return m;
 }
 
+// A grid of `dims` voxels of edge 0.03 turned by `rodrigues`, centred at `centre`, carved by the
+// blob silhouettes of three views 50 degrees apart (holes, thin parts).
+VoxelGrid carvedBlobGrid(CameraModel model, const Vec3i& dims, const Vec3d& rodrigues,
+                         const Vec3d& centre, Size size, RNG& rng)
+{
+    VoxelGrid g;
+    const Matx33d Rb = rotationFromRodrigues(rodrigues);
+    const double h = 0.03;
+    g.create(dims, Rb, Rb * (Vec3d(-dims[0], -dims[1], -dims[2]) * (0.5 * h)) + centre, h, 1);
+    std::vector<CarveView> views;
+    for (int v = 0; v < 3; v++)
+        views.push_back(g.carveView(lookAtCamera(model, 50.0 * v - 40, 20, 30, size, 40),
+                                    blobMask(size, rng)));
+    g.carve(views);
+    return g;
+}
+
 typedef testing::TestWithParam<int> Augocc_VoxelGrid_P;
 
 // The row walk skips voxels by distance bounds: its result must equal the plain per-voxel test.
@@ -164,17 +181,9 @@ TEST(Augocc_VoxelGrid, coverage_equals_depth_matte)
     for (int model = 0; model < 2; model++)
         for (double az : {0.0, 47.0})
         {
-            VoxelGrid g;
-            const Matx33d Rb = rotationFromRodrigues(Vec3d(0.2, -0.4, 0.1));
-            const double h = 0.03;
-            const Vec3i dims(120, 110, 100);
-            g.create(dims, Rb, Rb * (Vec3d(-dims[0], -dims[1], -dims[2]) * (0.5 * h)) +
-                                   Vec3d(az > 0 ? 2.0 : 0.0, 0, 0), h, 1);
-            std::vector<CarveView> views;
-            for (int v = 0; v < 3; v++)
-                views.push_back(g.carveView(lookAtCamera((CameraModel)model, 50.0 * v - 40, 20,
-                                                         30, size, 40), blobMask(size, rng)));
-            g.carve(views);
+            const VoxelGrid g = carvedBlobGrid((CameraModel)model, Vec3i(120, 110, 100),
+                                               Vec3d(0.2, -0.4, 0.1),
+                                               Vec3d(az > 0 ? 2.0 : 0.0, 0, 0), size, rng);
             const SurfaceVoxels s = g.surface();
             ASSERT_GT(s.size(), (size_t)1000);
             std::vector<uint32_t> extra;  // every 7th inside voxel, as a patch list
@@ -213,16 +222,8 @@ TEST(Augocc_VoxelGrid, splat_window_equals_crop)
         {
             if (model == SCALED_ORTHOGRAPHIC && dist < 10)
                 continue;
-            VoxelGrid g;
-            const Matx33d Rb = rotationFromRodrigues(Vec3d(0.3, 0.5, -0.2));
-            const double h = 0.03;
-            const Vec3i dims(90, 100, 80);
-            g.create(dims, Rb, Rb * (Vec3d(-dims[0], -dims[1], -dims[2]) * (0.5 * h)), h, 1);
-            std::vector<CarveView> views;
-            for (int v = 0; v < 3; v++)
-                views.push_back(g.carveView(lookAtCamera((CameraModel)model, 50.0 * v - 40, 20,
-                                                         30, size, 40), blobMask(size, rng)));
-            g.carve(views);
+            const VoxelGrid g = carvedBlobGrid((CameraModel)model, Vec3i(90, 100, 80),
+                                               Vec3d(0.3, 0.5, -0.2), Vec3d(0, 0, 0), size, rng);
             const SurfaceVoxels s = g.surface();
             ASSERT_GT(s.size(), (size_t)1000);
             const Camera cam = lookAtCamera((CameraModel)model, 23, 31, dist, size,
