@@ -12,7 +12,10 @@
 // run none of whose voxels any frame shows (first along its line of sight among every clone's
 // voxels, in UnobservedParams::views evenly spaced frames and every key frame) goes. The inside
 // of a building under its seen roof, the hidden back of a shaft under its seen cap, stay (their
-// run holds a seen voxel); a wedge with air above it and the ground below goes.
+// run holds a seen voxel); a wedge with air above it and the ground below goes. The unseen runs
+// are opened first (UnobservedParams::keepNearSeen, regrowFromUnseen): one beside a seen run
+// stays unless a wide unseen region is near, since under a top seen at a grazing angle only some
+// top voxels pass the depth test.
 
 #include "precomp.hpp"
 #include "clone/passes.hpp"
