@@ -51,6 +51,22 @@ std::string writeText(const std::string& dir, const std::string& name, const std
     return path;
 }
 
+std::string fileText(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::vector<std::string> filesUnder(const std::string& dir)
+{
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+        if (e.is_regular_file())
+            files.push_back(std::filesystem::relative(e.path(), dir).string());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
 std::string tempDir(const std::string& tag)
 {
     const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();

@@ -32,6 +32,12 @@ std::string tempDir(const std::string& tag);
 //! Writes `text` to `dir`/`name` and returns that path.
 std::string writeText(const std::string& dir, const std::string& name, const std::string& text);
 
+//! The whole content of a file (empty if it cannot be read).
+std::string fileText(const std::string& path);
+
+//! The regular files under `dir`, recursively, as paths relative to it, sorted.
+std::vector<std::string> filesUnder(const std::string& dir);
+
 //! Path of the built augocc binary.
 std::string augoccBinary();
 //! Runs a shell command, returns its exit status; stdout+stderr are captured into *output.

@@ -100,15 +100,9 @@ std::map<String, std::pair<long long, long long> > outputIds(const String& out)
 // Every matte PNG of `a` equals `b`'s, and the folders hold the same files.
 testing::AssertionResult sameMattes(const String& a, const String& b)
 {
-    std::vector<String> files;
-    for (const auto& e : fs::recursive_directory_iterator(a))
-        if (e.is_regular_file())
-            files.push_back(fs::relative(e.path(), a).string());
-    int nb = 0;
-    for (const auto& e : fs::recursive_directory_iterator(b))
-        nb += e.is_regular_file() ? 1 : 0;
-    if (files.empty() || (int)files.size() != nb)
-        return testing::AssertionFailure() << files.size() << " mattes against " << nb;
+    const std::vector<std::string> files = filesUnder(a), inB = filesUnder(b);
+    if (files.empty() || files != inB)
+        return testing::AssertionFailure() << files.size() << " mattes against " << inB.size();
     for (const String& f : files)
     {
         const Mat ma = imread(a + "/" + f, IMREAD_UNCHANGED), mb = imread(b + "/" + f,

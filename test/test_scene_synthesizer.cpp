@@ -478,19 +478,9 @@ TEST(Augocc_SceneSynthesizer, streamed_write_equals_in_memory)
     writeSyntheticScene(memDir, scene, p);
     synth->write(streamDir);
 
-    std::vector<std::string> files;
-    for (const auto& e : fs::recursive_directory_iterator(memDir))
-        if (e.is_regular_file())
-            files.push_back(fs::relative(e.path(), memDir).string());
-    size_t streamed = 0;
-    for (const auto& e : fs::recursive_directory_iterator(streamDir))
-        streamed += e.is_regular_file() ? 1 : 0;
-    EXPECT_EQ(streamed, files.size()) << "the same files";
+    const std::vector<std::string> files = filesUnder(memDir);
+    EXPECT_EQ(filesUnder(streamDir), files) << "the same files";
     ASSERT_GT(files.size(), (size_t)(10 * (2 + 2 * 3 + 1)));
-    auto text = [](const std::string& path) {
-        std::ifstream in(path, std::ios::binary);
-        return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    };
     const double scaleMem = (double)FileStorage(memDir + "/gt/depth/depth.yml",
                                                 FileStorage::READ)["scale"];
     const double scaleStream = (double)FileStorage(streamDir + "/gt/depth/depth.yml",
@@ -523,7 +513,7 @@ TEST(Augocc_SceneSynthesizer, streamed_write_equals_in_memory)
         }
         else if (ext == ".yml" && rel != "gt/depth/depth.yml")
         {
-            EXPECT_EQ(text(a), text(b)) << rel;
+            EXPECT_EQ(fileText(a), fileText(b)) << rel;
             compared++;
         }
     }

@@ -879,53 +879,15 @@ struct CoverSpans
     }
 };
 
-/* The voxels i of a grid row whose affine footprint can meet the pixels [X0, X1] x [Y0, Y1]:
-[iLo, iHi] (empty when iLo > iHi), with a margin. The centre u = mu i + au; the footprint's
-columns lie within [u - ru - 0.5, u + ru + 0.5] (VoxelProjector::footprint: the ceiling of
-u - ru or the rounded centre, the floor of u + ru or the rounded centre), so a voxel is drawn
-only when u lies within [X0 - ru - 0.5, X1 + ru + 0.5]; and the same for the rows. The bounds
-solved for i are widened by one voxel against the rounding of the divisions. */
-void footprintRowRange(double mu, double au, double ru, int X0, int X1, double mv, double av,
-                       double rv, int Y0, int Y1, int& iLo, int& iHi)
-{
-    double lo = -2, hi = 1026;  // every i a packed voxel holds, and a margin
-    auto cut = [&](double m, double a, double r, int P0, int P1) {
-        const double pLo = P0 - r - 1.0, pHi = P1 + r + 1.0;
-        if (!(pLo <= pHi))
-        {
-            hi = lo - 1;
-            return;
-        }
-        if (m == 0)
-        {
-            if (!(a >= pLo && a <= pHi))
-                hi = lo - 1;
-            return;
-        }
-        double t0 = (pLo - a) / m, t1 = (pHi - a) / m;
-        if (t0 > t1)
-            std::swap(t0, t1);
-        lo = std::max(lo, t0 - 1);
-        hi = std::min(hi, t1 + 1);
-    };
-    cut(mu, au, ru, X0, X1);
-    cut(mv, av, rv, Y0, Y1);
-    if (!(lo <= hi))  // also NaN
-    {
-        iLo = 0;
-        iHi = -1;
-        return;
-    }
-    iLo = (int)std::floor(lo);
-    iHi = (int)std::ceil(hi);
-}
-
-/* Perspective: the voxels i of a row (homogeneous centre (m i + a, ., mw i + aw), w > 0 over
-the row) whose centre column u lies within [P0 - r - 1, P1 + r + 1], r a bound of the
-footprint's half width over the row: u >= L is (m - L mw) i + (a - L aw) >= 0 there, linear.
-Widened by one voxel against rounding. */
-void perspectiveRowRange(double m, double a, double r, int P0, int P1, double mw, double aw,
-                         int& iLo, int& iHi)
+/* The voxels i of a grid row (homogeneous centre (m i + a, ., mw i + aw), w > 0 over the row;
+affine: mw = 0, aw = 1) whose footprint can meet the pixels [P0, P1] along one image axis: the
+footprint's pixels lie within [u - r - 0.5, u + r + 0.5] (VoxelProjector::footprint: the ceiling
+of u - r or the rounded centre, the floor of u + r or the rounded centre), r its half width or a
+bound of it over the row, so a voxel is drawn only when u lies within [P0 - r - 1, P1 + r + 1]
+(a pixel of margin); u >= L is (m - L mw) i + (a - L aw) >= 0, linear in i. [iLo, iHi], empty
+when iLo > iHi, widened by one voxel against the rounding of the division. */
+void rowRange(double m, double a, double r, int P0, int P1, double mw, double aw, int& iLo,
+              int& iHi)
 {
     double lo = -2, hi = kMaxGridDim + 3;
     auto atLeast = [&](double c1, double c0) {  // c1 i + c0 >= 0
@@ -997,7 +959,11 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
                 a0 = M(0, 1) * j + M(0, 2) * k + proj.c[0];
                 a1 = M(1, 1) * j + M(1, 2) * k + proj.c[1];
                 az = proj.Z[1] * j + proj.Z[2] * k + proj.z0;
-                footprintRowRange(M(0, 0), a0, ru, X0, X1, M(1, 0), a1, rv, Y0, Y1, iLo, iHi);
+                int lo2, hi2;
+                rowRange(M(0, 0), a0, ru, X0, X1, 0, 1, iLo, iHi);
+                rowRange(M(1, 0), a1, rv, Y0, Y1, 0, 1, lo2, hi2);
+                iLo = std::max(iLo, lo2);
+                iHi = std::min(iHi, hi2);
             }
             if (i < iLo || i > iHi)
                 continue;
@@ -1044,9 +1010,9 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
                 const double vMax = std::max(std::abs(b1), std::abs(M(1, 0) * iMax + b1)) / wMin;
                 const double ruB = 0.5 * (S0 + uMax * S2) / wMin;
                 const double rvB = 0.5 * (S1 + vMax * S2) / wMin;
-                perspectiveRowRange(M(0, 0), b0, ruB, X0, X1, M(2, 0), b2, iLo, iHi);
+                rowRange(M(0, 0), b0, ruB, X0, X1, M(2, 0), b2, iLo, iHi);
                 int lo2, hi2;
-                perspectiveRowRange(M(1, 0), b1, rvB, Y0, Y1, M(2, 0), b2, lo2, hi2);
+                rowRange(M(1, 0), b1, rvB, Y0, Y1, M(2, 0), b2, lo2, hi2);
                 iLo = std::max(iLo, lo2);
                 iHi = std::min(iHi, hi2);
             }

@@ -130,9 +130,9 @@ int64 passUnobserved(ObjectClone& obj, const PassContext& ctx)
     struct Run
     {
         int t0, t1;
-        uchar state;  // kSeen, kUnseen, or after the erosion kKept (beside a seen run) / kCore
+        bool seen;
+        bool core;  // unseen, and no seen run within keepNearSeen columns (the erosion's)
     };
-    enum : uchar { kSeen, kUnseen, kKept, kCore };
     std::vector<std::vector<Run> > cols((size_t)nu * nv);
     parallel_for_(Range(0, nv), [&](const Range& r) {
         for (int b = r.start; b < r.end; b++)
@@ -165,20 +165,20 @@ int64 passUnobserved(ObjectClone& obj, const PassContext& ctx)
                         continue;
                     }
                     if (start >= 0)
-                        runs.push_back(Run{start, t, any ? kSeen : kUnseen});
+                        runs.push_back(Run{start, t, any, false});
                     start = -1;
                 }
             }
     });
-    // Has a column within `reach` of (a, b) (not itself) a run in `state` overlapping [t0, t1)?
-    auto near = [&](int a, int b, int t0, int t1, uchar state, int reach) {
+    // Has a column within `reach` of (a, b) (not itself) a run with `flag` overlapping [t0, t1)?
+    auto near = [&](int a, int b, int t0, int t1, bool Run::*flag, int reach) {
         for (int bb = std::max(0, b - reach); bb <= std::min(nv - 1, b + reach); bb++)
             for (int aa = std::max(0, a - reach); aa <= std::min(nu - 1, a + reach); aa++)
             {
                 if (aa == a && bb == b)
                     continue;
                 for (const Run& o : cols[(size_t)bb * nu + aa])
-                    if (o.state == state && o.t0 < t1 && t0 < o.t1)
+                    if (o.*flag && o.t0 < t1 && t0 < o.t1)
                         return true;
             }
         return false;
@@ -187,50 +187,32 @@ int64 passUnobserved(ObjectClone& obj, const PassContext& ctx)
     // under a roof seen at a grazing angle only some tops pass the depth test, and runs under the
     // others would leave the clone riddled with shafts), then grown back (one within
     // regrowFromUnseen columns of a run the erosion left goes: the thin edges of a hidden wedge).
-    std::vector<std::vector<uchar> > kept(nv);
+    // Each step reads one flag and writes another, so the columns go in parallel.
     parallel_for_(Range(0, nv), [&](const Range& r) {
         for (int b = r.start; b < r.end; b++)
-        {
-            std::vector<uchar>& k = kept[b];
             for (int a = 0; a < nu; a++)
-                for (const Run& R : cols[(size_t)b * nu + a])
-                    if (R.state == kUnseen)
-                        k.push_back(near(a, b, R.t0, R.t1, kSeen, p.keepNearSeen) ? 1 : 0);
-        }
+                for (Run& R : cols[(size_t)b * nu + a])
+                    R.core = !R.seen && !near(a, b, R.t0, R.t1, &Run::seen, p.keepNearSeen);
     });
-    for (int b = 0; b < nv; b++)
-    {
-        size_t q = 0;
-        for (int a = 0; a < nu; a++)
-            for (Run& R : cols[(size_t)b * nu + a])
-                if (R.state == kUnseen)
-                    R.state = kept[b][q++] ? kKept : kCore;
-    }
     std::vector<int64> perSlice(nv, 0);
-    std::vector<std::vector<std::pair<int, const Run*> > > gone(nv);
     parallel_for_(Range(0, nv), [&](const Range& r) {
         for (int b = r.start; b < r.end; b++)
             for (int a = 0; a < nu; a++)
                 for (const Run& R : cols[(size_t)b * nu + a])
-                    if (R.state == kCore ||
-                        (R.state == kKept && near(a, b, R.t0, R.t1, kCore, p.regrowFromUnseen)))
-                        gone[b].push_back(std::make_pair(a, &R));
-    });
-    // The runs go after every decision (a run removed early would change its neighbours').
-    parallel_for_(Range(0, nv), [&](const Range& r) {
-        for (int b = r.start; b < r.end; b++)
-            for (const auto& ar : gone[b])
-            {
-                int idx[3];
-                idx[u] = ar.first;
-                idx[v] = b;
-                for (int w = ar.second->t0; w < ar.second->t1; w++)
                 {
-                    idx[axis] = w;
-                    g.data[g.index(idx[0], idx[1], idx[2])] = 0;
+                    if (R.seen ||
+                        !(R.core || near(a, b, R.t0, R.t1, &Run::core, p.regrowFromUnseen)))
+                        continue;
+                    int idx[3];
+                    idx[u] = a;
+                    idx[v] = b;
+                    for (int w = R.t0; w < R.t1; w++)
+                    {
+                        idx[axis] = w;
+                        g.data[g.index(idx[0], idx[1], idx[2])] = 0;
+                    }
+                    perSlice[b] += R.t1 - R.t0;
                 }
-                perSlice[b] += ar.second->t1 - ar.second->t0;
-            }
     });
     for (int64 c : perSlice)
         count += c;
