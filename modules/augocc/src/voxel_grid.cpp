@@ -136,7 +136,7 @@ VoxelProjector VoxelGrid::projector(const Camera& camera, Size imageSize) const
     p.size = imageSize;
     p.viewDir = RbT * camera.viewDirection();
     p.camVoxel = toVoxel(camera.center());
-    p.rowLength = dims[0];
+    p.dims = dims;
     if (p.affine)
     {
         // Half extents of the projected cube: half the sum of |edge projections| (exact).
@@ -934,6 +934,12 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
             if (proj.viewDir[a] < 0) frontMask |= (uchar)(1 << (2 * a + 1));
         }
     const bool cull = frontOnly && faces;
+    // Row bounds only when the buffer can clip a footprint away: a matte over the whole image
+    // holds every footprint, and rows of a surface list are short (the bounds cost about as
+    // much as the footprints they save).
+    const Rect window(Point(X0, Y0), Point(X1 + 1, Y1 + 1));
+    const Rect all = projectedBounds(proj);
+    const bool bounded = (all & window) != all;
     if (proj.affine && out.affineFast())
     {
         // The renderer's path: VoxelProjector::footprint's arithmetic term for term (so key
@@ -945,7 +951,7 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
         const Matx33d& M = proj.M;
         uint32_t lastRow = ~0u;
         double a0 = 0, a1 = 0, az = 0;
-        int iLo = 0, iHi = -1;
+        int iLo = 0, iHi = kMaxGridDim;
         for (size_t q = 0; q < n; q++)
         {
             if (cull && !(faces[q] & frontMask))
@@ -959,11 +965,14 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
                 a0 = M(0, 1) * j + M(0, 2) * k + proj.c[0];
                 a1 = M(1, 1) * j + M(1, 2) * k + proj.c[1];
                 az = proj.Z[1] * j + proj.Z[2] * k + proj.z0;
-                int lo2, hi2;
-                rowRange(M(0, 0), a0, ru, X0, X1, 0, 1, iLo, iHi);
-                rowRange(M(1, 0), a1, rv, Y0, Y1, 0, 1, lo2, hi2);
-                iLo = std::max(iLo, lo2);
-                iHi = std::min(iHi, hi2);
+                if (bounded)  // else iLo, iHi hold every i
+                {
+                    int lo2, hi2;
+                    rowRange(M(0, 0), a0, ru, X0, X1, 0, 1, iLo, iHi);
+                    rowRange(M(1, 0), a1, rv, Y0, Y1, 0, 1, lo2, hi2);
+                    iLo = std::max(iLo, lo2);
+                    iHi = std::min(iHi, hi2);
+                }
             }
             if (i < iLo || i > iHi)
                 continue;
@@ -983,14 +992,14 @@ void splat(const VoxelProjector& proj, const uint32_t* ijk, const uchar* faces, 
     const double S0 = std::abs(M(0, 0)) + std::abs(M(0, 1)) + std::abs(M(0, 2));
     const double S1 = std::abs(M(1, 0)) + std::abs(M(1, 1)) + std::abs(M(1, 2));
     const double S2 = std::abs(M(2, 0)) + std::abs(M(2, 1)) + std::abs(M(2, 2));
-    const int iMax = std::max(0, std::min(proj.rowLength, kMaxGridDim + 1) - 1);
+    const int iMax = std::max(0, std::min(proj.dims[0], kMaxGridDim + 1) - 1);
     uint32_t lastRow = ~0u;
-    int iLo = 0, iHi = -1;
+    int iLo = 0, iHi = kMaxGridDim;
     for (size_t q = 0; q < n; q++)
     {
         int i, j, k;
         unpackVoxel(ijk[q], i, j, k);
-        if (!proj.affine && (ijk[q] >> 10) != lastRow)
+        if (bounded && !proj.affine && (ijk[q] >> 10) != lastRow)
         {
             // The row's voxels whose footprint can meet the buffer (as in the affine path).
             // Where the row is in front of the camera (w > 0 at both ends of the grid's row,
@@ -1060,10 +1069,11 @@ void splatVoxels(const VoxelProjector& proj, const uint32_t* ijk, const uchar* f
     splat(proj, ijk, faces, n, frontOnly, zmin.size(), DepthSpans(zmin, offset, zmax));
 }
 
-Rect VoxelGrid::imageBounds(const VoxelProjector& proj) const
+Rect projectedBounds(const VoxelProjector& proj)
 {
     // Footprints of the corner voxels bound every footprint (projection of a box is the hull of
     // its corners; the footprint adds at most the corner voxel's own extent).
+    const Vec3i& dims = proj.dims;
     int x0 = INT_MAX, y0 = INT_MAX, x1 = INT_MIN, y1 = INT_MIN;
     for (int c = 0; c < 8; c++)
     {

@@ -61,7 +61,7 @@ struct VoxelProjector
     Vec3d viewDir;    //!< affine: viewing direction in voxel coordinates
     Vec3d camVoxel;   //!< perspective: camera centre in voxel coordinates
     double ruAffine = 0, rvAffine = 0;  //!< affine: footprint half extents in pixels
-    int rowLength = kMaxGridDim + 1;    //!< the grid's voxels along i (renderers' row bounds)
+    Vec3i dims = Vec3i::all(kMaxGridDim + 1);  //!< the grid's size (renderers' bounds)
 
     /** @brief Pixel (rounded) of the centre of voxel (i, j, k). Returns false when the voxel is
     not in front of the camera. */
@@ -119,6 +119,10 @@ struct VoxelProjector
         return true;
     }
 };
+
+/** @brief Pixels every footprint of the projector's grid lies in (the footprints of its corner
+voxels, and a pixel), within the image; the whole image when a corner is behind the camera. */
+CV_EXPORTS Rect projectedBounds(const VoxelProjector& proj);
 
 /** @brief One key frame prepared for carving: keep-label image (silhouette or unknown = 255,
 outside = 0) padded by `pad` keep pixels, and the chessboard distance of every pixel to the
@@ -205,7 +209,7 @@ public:
     //! Exposed faces of the surface as a mesh in world coordinates (two triangles per face).
     Mesh surfaceMesh(const SurfaceVoxels& s) const;
     //! Pixel rectangle (clipped to the image) holding every voxel footprint of the grid.
-    Rect imageBounds(const VoxelProjector& proj) const;
+    Rect imageBounds(const VoxelProjector& proj) const { return projectedBounds(proj); }
     //! Cubes of a list of voxels as a mesh in world coordinates.
     Mesh cubesMesh(const std::vector<uint32_t>& voxels) const;
 };
